@@ -1,0 +1,431 @@
+//! A fabric in SI: mass, thickness, friction, the tensile loop and the bending spindle in the four
+//! measured directions, and the per-angle [`MaterialTable`] the solver looks edges up in.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use crate::anisotropy::{self, AnisotropyForm, Directions, canonical_angle};
+use crate::bending::Spindle;
+use crate::error::{ErrorKind, FileError, InvalidValue};
+use crate::files;
+use crate::plausibility::{self, FabricClass, PlausibilityWarning};
+use crate::spec::{BendingSpec, FabricSpec, Provenance, ShearSpec, TensileSpec};
+use crate::tensile::{Branch, TABLE_SEGMENTS, TensileLoop, TensileState};
+use crate::units;
+
+/// Largest dip of an interpolated tensile branch, as a fraction of its apex strain, that
+/// [`Fabric::tensile_at`] repairs by a running maximum rather than rejecting.
+pub const MAX_MONOTONE_REPAIR: f64 = 0.01;
+
+/// Standard gravity, m/s² (used for weight per area and bending lengths).
+pub const STANDARD_GRAVITY: f64 = 9.80665;
+
+/// KES shear values in SI.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shear {
+    /// Shear stiffness G, N/(m·rad).
+    pub stiffness: f64,
+    /// Hysteresis width 2HG at 0.5°, N/m.
+    pub hysteresis: f64,
+    /// Hysteresis width 2HG5 at 5°, N/m (reports only).
+    pub hysteresis_5deg: Option<f64>,
+}
+
+impl Shear {
+    /// From the file's KES values.
+    pub fn from_spec(s: &ShearSpec) -> Self {
+        Self {
+            stiffness: units::shear_stiffness_from_kes(s.g_gf_cm_deg),
+            hysteresis: units::force_from_kes(s.two_hg_gf_cm),
+            hysteresis_5deg: s.two_hg5_gf_cm.map(units::force_from_kes),
+        }
+    }
+
+    /// Shear angle (rad) at shear force per width `tau` (N/m) on the bilinear KES loop
+    /// `τ = Gγ ± HG`: loading from rest sticks until τ exceeds HG.
+    pub fn loading_angle(&self, tau: f64) -> f64 {
+        (tau - 0.5 * self.hysteresis).max(0.0) / self.stiffness
+    }
+}
+
+/// The bias (45°) tensile loop implied by warp, weft and shear data (`method.md` §1.4,
+/// generalised to the whole curve). Uniaxial force f along 45° puts f/2 on each yarn direction and
+/// a shear force f/2 on the weave; with ν ≈ 0 the bias strain is
+/// `ε₄₅(f) = ½ φ_v(f/2) + ½ φ_u(f/2) + ½ γ(f/2)`, which at small strain is
+/// `1/E₄₅ = ¼ (1/E_v + 1/E_u + 1/G)`. The shear angle γ follows the bilinear KES shear loop with
+/// half-width HG = 2HG/2; on unloading the yarn terms follow their minor loops from f_max/2 (thesis
+/// (40)) and γ its unloading branch, so the bias loop closes at its apex.
+pub fn bias_from_shear(
+    warp: &TensileLoop,
+    weft: &TensileLoop,
+    shear: &Shear,
+) -> Result<TensileLoop, InvalidValue> {
+    let f_max = warp.max_force().min(weft.max_force());
+    let turn = |l: &TensileLoop| {
+        let mut s = TensileState::VIRGIN;
+        s.update(l, 0.5 * f_max);
+        s
+    };
+    let (turn_v, turn_u) = (turn(warp), turn(weft));
+    let hg = 0.5 * shear.hysteresis;
+    let gamma_max = shear.loading_angle(0.5 * f_max);
+    TensileLoop::from_fn(f_max, |f| {
+        let tau = 0.5 * f;
+        let up = warp.strain(Branch::Loading, tau)
+            + weft.strain(Branch::Loading, tau)
+            + shear.loading_angle(tau);
+        let down = turn_v.strain(warp, tau)
+            + turn_u.strain(weft, tau)
+            + ((tau + hg) / shear.stiffness).min(gamma_max);
+        (0.5 * up, 0.5 * down)
+    })
+    .map_err(|e| e.within("shear"))
+}
+
+/// A fabric's mechanics in SI units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fabric {
+    /// Name.
+    pub name: String,
+    /// Provenance of the values.
+    pub provenance: Provenance,
+    /// Class for the plausibility bands, if stated.
+    pub class: Option<FabricClass>,
+    /// Mass per area, kg/m².
+    pub mass_per_area: f64,
+    /// Thickness, m.
+    pub thickness: f64,
+    /// Static friction coefficient on itself.
+    pub friction: f64,
+    /// Tensile loops in the measured directions (bias ones measured or derived).
+    pub tensile: Directions<TensileLoop>,
+    /// Bending characteristics in the measured directions (bias ones measured or derived).
+    pub bending: Directions<Spindle>,
+    /// KES shear values, if given.
+    pub shear: Option<Shear>,
+}
+
+impl Fabric {
+    /// Load a fabric file (RON).
+    pub fn load(path: &Path) -> Result<Self, FileError> {
+        let spec: FabricSpec = files::load_ron(path)?;
+        Self::from_spec(&spec).map_err(|e| FileError::from_invalid(path, e))
+    }
+
+    /// Parse fabric RON text; `file` names the source in errors.
+    pub fn from_ron_str(text: &str, file: &Path) -> Result<Self, FileError> {
+        let spec: FabricSpec = files::parse_ron(text, file)?;
+        Self::from_spec(&spec).map_err(|e| FileError::from_invalid(file, e))
+    }
+
+    /// Convert a fabric description (KES units) to SI, synthesising curves from summary values,
+    /// deriving the 45° tensile loop from shear and the bias bending from warp and weft where they
+    /// are not given.
+    pub fn from_spec(spec: &FabricSpec) -> Result<Self, InvalidValue> {
+        let tensile_of = |t: &TensileSpec, field: &str| -> Result<TensileLoop, InvalidValue> {
+            match t {
+                TensileSpec::Kes(k) => TensileLoop::from_summary(&k.summary()),
+                TensileSpec::Measured(m) => m.to_loop(),
+            }
+            .map_err(|e| e.within(field))
+        };
+        let bending_of = |b: &BendingSpec, field: &str| -> Result<Spindle, InvalidValue> {
+            match b {
+                BendingSpec::Kes(k) => Spindle::from_kes(k.b_gf_cm2_cm, k.two_hb_gf_cm_cm),
+                BendingSpec::Measured(m) => m.fit().map(|f| f.spindle),
+            }
+            .map_err(|e| e.within(field))
+        };
+        let warp = tensile_of(&spec.tensile.warp, "tensile.warp")?;
+        let weft = tensile_of(&spec.tensile.weft, "tensile.weft")?;
+        let shear = spec.shear.as_ref().map(Shear::from_spec);
+        let bias45 = match (&spec.tensile.bias45, &shear) {
+            (Some(t), _) => tensile_of(t, "tensile.bias45")?,
+            (None, Some(s)) => bias_from_shear(&warp, &weft, s)?,
+            (None, None) => {
+                return Err(InvalidValue::new(
+                    ErrorKind::MissingField,
+                    "tensile.bias45",
+                    "no bias tensile data: give measured 45° curves or a `shear` section",
+                ));
+            }
+        };
+        let bias135 = match &spec.tensile.bias135 {
+            Some(t) => tensile_of(t, "tensile.bias135")?,
+            None => bias45.clone(),
+        };
+        let bwarp = bending_of(&spec.bending.warp, "bending.warp")?;
+        let bweft = bending_of(&spec.bending.weft, "bending.weft")?;
+        let b45 = match &spec.bending.bias45 {
+            Some(b) => bending_of(b, "bending.bias45")?,
+            None => Spindle::new(
+                anisotropy::huber_bias(bwarp.rigidity(), bweft.rigidity()),
+                anisotropy::huber_bias(bwarp.residual_moment(), bweft.residual_moment()),
+            )
+            .map_err(|e| e.within("bending.bias45"))?,
+        };
+        let b135 = match &spec.bending.bias135 {
+            Some(b) => bending_of(b, "bending.bias135")?,
+            None => b45,
+        };
+        Ok(Self {
+            name: spec.name.clone(),
+            provenance: spec.provenance.clone(),
+            class: spec.class,
+            mass_per_area: units::mass_per_area_from_kes(spec.mass_per_area_mg_cm2),
+            thickness: units::thickness_from_kes(spec.thickness_mm),
+            friction: spec.friction,
+            tensile: Directions {
+                warp,
+                weft,
+                bias45,
+                bias135,
+            },
+            bending: Directions {
+                warp: bwarp,
+                weft: bweft,
+                bias45: b45,
+                bias135: b135,
+            },
+            shear,
+        })
+    }
+
+    /// Weight per area w = m_A·g, N/m².
+    pub fn weight_per_area(&self) -> f64 {
+        self.mass_per_area * STANDARD_GRAVITY
+    }
+
+    /// Bending length c = (B/w)^(1/3) at material angle `theta` (m), the cantilever's scale.
+    pub fn bending_length(&self, theta: f64, form: AnisotropyForm) -> Result<f64, InvalidValue> {
+        Ok((self.bending_at(theta, form)?.rigidity() / self.weight_per_area()).cbrt())
+    }
+
+    /// The tensile loop at material angle `theta` (rad from the warp), interpolated knot by knot
+    /// from the warp, weft and bias loops (`method.md` §1.3) up to the smallest apex force of the
+    /// three. Build once per distinct angle ([`MaterialTable`]), never per edge per step.
+    ///
+    /// The interpolation weights change sign inside each quadrant, so an interpolated branch can
+    /// dip slightly (the thesis form on the denim fixture at 56.25°: by 5e-5 of its strain near
+    /// Fm). Such dips are repaired by a running maximum along each branch (and the unloading
+    /// branch is kept at or above the loading one); a repair larger than
+    /// [`MAX_MONOTONE_REPAIR`] of the apex strain is an error. [`MaterialTable::repair`] reports
+    /// the size of each repair.
+    pub fn tensile_at(
+        &self,
+        theta: f64,
+        form: AnisotropyForm,
+    ) -> Result<TensileLoop, InvalidValue> {
+        self.tensile_at_repaired(theta, form).map(|(l, _)| l)
+    }
+
+    fn tensile_at_repaired(
+        &self,
+        theta: f64,
+        form: AnisotropyForm,
+    ) -> Result<(TensileLoop, f64), InvalidValue> {
+        let d = &self.tensile;
+        let bias = d.bias_for(theta);
+        let f_max = d
+            .warp
+            .max_force()
+            .min(d.weft.max_force())
+            .min(bias.max_force());
+        let deg = theta.to_degrees();
+        let mut tables = [
+            Vec::with_capacity(TABLE_SEGMENTS + 1),
+            Vec::with_capacity(TABLE_SEGMENTS + 1),
+        ];
+        for j in 0..=TABLE_SEGMENTS {
+            let a = j as f64 / TABLE_SEGMENTS as f64;
+            let f = f_max * a * a;
+            for (branch, table) in [Branch::Loading, Branch::Unloading]
+                .into_iter()
+                .zip(tables.iter_mut())
+            {
+                let v = anisotropy::interpolate(
+                    form,
+                    theta,
+                    d.warp.strain(branch, f),
+                    d.weft.strain(branch, f),
+                    bias.strain(branch, f),
+                )
+                .ok_or_else(|| {
+                    InvalidValue::new(
+                        ErrorKind::OutOfRange,
+                        "tensile",
+                        format!("the {form:?} form gives no positive strain at θ = {deg:.2}°, f = {f:.4} N/m ({branch:?})"),
+                    )
+                })?;
+                table.push(v);
+            }
+        }
+        let [mut load, mut unload] = tables;
+        let mut repair: f64 = 0.0;
+        for table in [&mut load, &mut unload] {
+            for j in 1..table.len() {
+                if table[j] < table[j - 1] {
+                    repair = repair.max(table[j - 1] - table[j]);
+                    table[j] = table[j - 1];
+                }
+            }
+        }
+        for (u, l) in unload.iter_mut().zip(&load) {
+            if *u < *l {
+                repair = repair.max(*l - *u);
+                *u = *l;
+            }
+        }
+        let apex = load[TABLE_SEGMENTS];
+        if repair > MAX_MONOTONE_REPAIR * apex {
+            return Err(InvalidValue::new(
+                ErrorKind::NonMonotone,
+                "tensile",
+                format!(
+                    "the {form:?} form at θ = {deg:.2}° gives branches that fall or cross by {:.3} % of \
+                     the apex strain (more than {} % cannot be repaired); try the other form",
+                    100.0 * repair / apex,
+                    100.0 * MAX_MONOTONE_REPAIR
+                ),
+            ));
+        }
+        let l = TensileLoop::from_knots(f_max, load, unload).map_err(|e| {
+            InvalidValue::new(
+                e.kind,
+                "tensile",
+                format!("at θ = {deg:.2}° ({form:?} form): {}", e.message),
+            )
+        })?;
+        Ok((l, repair / apex))
+    }
+
+    /// The bending characteristic at material angle `theta`: B and M₀ each interpolated with
+    /// `form` (so every direction keeps the spindle shape of assumption (I)).
+    pub fn bending_at(&self, theta: f64, form: AnisotropyForm) -> Result<Spindle, InvalidValue> {
+        let d = &self.bending;
+        let bias = d.bias_for(theta);
+        let deg = theta.to_degrees();
+        let undefined = |what: &str| {
+            InvalidValue::new(
+                ErrorKind::OutOfRange,
+                "bending",
+                format!("the {form:?} form gives no valid {what} at θ = {deg:.2}°"),
+            )
+        };
+        let b = anisotropy::interpolate(
+            form,
+            theta,
+            d.warp.rigidity(),
+            d.weft.rigidity(),
+            bias.rigidity(),
+        )
+        .ok_or_else(|| undefined("rigidity"))?;
+        let m0 = anisotropy::interpolate(
+            form,
+            theta,
+            d.warp.residual_moment(),
+            d.weft.residual_moment(),
+            bias.residual_moment(),
+        )
+        .ok_or_else(|| undefined("residual moment"))?;
+        Spindle::new(b, m0).map_err(|e| e.within("bending"))
+    }
+
+    /// Values outside the typical bands of the fabric's class (see [`plausibility::check`]).
+    pub fn plausibility(&self) -> Vec<PlausibilityWarning> {
+        plausibility::check(self)
+    }
+}
+
+/// The characteristics at every distinct material angle of a grid's edges, built once.
+/// Angles equal modulo 180° (to 1e-9 rad) share an entry.
+#[derive(Clone, Debug)]
+pub struct MaterialTable {
+    form: AnisotropyForm,
+    angles: Vec<f64>,
+    tensile: Vec<TensileLoop>,
+    repairs: Vec<f64>,
+    bending: Vec<Spindle>,
+}
+
+impl MaterialTable {
+    /// Build the table for `edge_angles` (rad from the warp); returns it and, for each input
+    /// angle, the index of its entry.
+    pub fn build(
+        fabric: &Fabric,
+        form: AnisotropyForm,
+        edge_angles: &[f64],
+    ) -> Result<(Self, Vec<u32>), InvalidValue> {
+        let mut index_of: HashMap<i64, u32> = HashMap::new();
+        let mut table = Self {
+            form,
+            angles: Vec::new(),
+            tensile: Vec::new(),
+            repairs: Vec::new(),
+            bending: Vec::new(),
+        };
+        let mut indices = Vec::with_capacity(edge_angles.len());
+        for (e, &theta) in edge_angles.iter().enumerate() {
+            if !theta.is_finite() {
+                return Err(InvalidValue::new(
+                    ErrorKind::NotFinite,
+                    format!("[{e}]"),
+                    format!("edge angle {theta}"),
+                ));
+            }
+            let canon = canonical_angle(theta);
+            let key = (canon * 1e9).round() as i64;
+            let idx = match index_of.get(&key) {
+                Some(&i) => i,
+                None => {
+                    let i = table.angles.len() as u32;
+                    let (l, repair) = fabric.tensile_at_repaired(canon, form)?;
+                    table.tensile.push(l);
+                    table.repairs.push(repair);
+                    table.bending.push(fabric.bending_at(canon, form)?);
+                    table.angles.push(canon);
+                    index_of.insert(key, i);
+                    i
+                }
+            };
+            indices.push(idx);
+        }
+        Ok((table, indices))
+    }
+
+    /// The interpolation law used.
+    pub fn form(&self) -> AnisotropyForm {
+        self.form
+    }
+
+    /// Number of distinct angles.
+    pub fn len(&self) -> usize {
+        self.angles.len()
+    }
+
+    /// Whether the table is empty.
+    pub fn is_empty(&self) -> bool {
+        self.angles.is_empty()
+    }
+
+    /// Canonical angle (rad, in [0, π)) of entry `i`.
+    pub fn angle(&self, i: u32) -> f64 {
+        self.angles[i as usize]
+    }
+
+    /// Tensile loop of entry `i`.
+    pub fn tensile(&self, i: u32) -> &TensileLoop {
+        &self.tensile[i as usize]
+    }
+
+    /// Largest monotonicity repair of entry `i`'s tensile loop, as a fraction of its apex strain
+    /// (0 when the interpolated branches were monotone as computed).
+    pub fn repair(&self, i: u32) -> f64 {
+        self.repairs[i as usize]
+    }
+
+    /// Bending characteristic of entry `i`.
+    pub fn bending(&self, i: u32) -> &Spindle {
+        &self.bending[i as usize]
+    }
+}

@@ -1,0 +1,58 @@
+//! Project automation for atelier: `cargo xtask <command>`.
+//!
+//! - `cargo xtask figures fabric [--out DIR]` — the fabric-model figures (tensile minor loops,
+//!   bending loop, polar plots of the orthotropic interpolation), PNG, written atomically.
+
+mod figures_fabric;
+mod plot;
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand, ValueEnum};
+
+#[derive(Parser)]
+#[command(name = "xtask", about = "atelier project automation")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Draw the figures of a model.
+    Figures {
+        /// Which set of figures.
+        which: FigureSet,
+        /// Output folder (created if missing); default `figures/<set>` in the repository.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FigureSet {
+    /// Tensile and bending hysteresis, orthotropic interpolation.
+    Fabric,
+}
+
+fn repository_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Figures { which, out } => match which {
+            FigureSet::Fabric => {
+                let out = out.unwrap_or_else(|| repository_root().join("figures/fabric"));
+                std::fs::create_dir_all(&out)?;
+                plot::register_font()?;
+                for written in figures_fabric::draw_all(&repository_root(), &out)? {
+                    eprintln!("wrote {}", written.display());
+                }
+            }
+        },
+    }
+    Ok(())
+}
