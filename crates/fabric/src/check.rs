@@ -63,6 +63,20 @@ pub(crate) fn opt_non_negative<'de, D: Deserializer<'de>>(d: D) -> Result<Option
         .map_err(D::Error::custom)
 }
 
+pub(crate) fn opt_locking_angle<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    let v = opt_positive(d)?;
+    if let Some(deg) = v
+        && deg >= 90.0
+    {
+        return Err(D::Error::custom(InvalidValue::new(
+            ErrorKind::OutOfRange,
+            "",
+            format!("{deg}° must lie below 90°"),
+        )));
+    }
+    Ok(v)
+}
+
 pub(crate) fn non_empty<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     let s = String::deserialize(d)?;
     if s.trim().is_empty() {

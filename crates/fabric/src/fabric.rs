@@ -20,7 +20,12 @@ pub const MAX_MONOTONE_REPAIR: f64 = 0.01;
 /// Standard gravity, m/s² (used for weight per area and bending lengths).
 pub const STANDARD_GRAVITY: f64 = 9.80665;
 
-/// KES shear values in SI.
+/// Default shear locking angle (rad): the trellis angle at which the yarns of a woven fabric
+/// jam. Typical woven fabrics lock between 30° and 50°; 40° is a banded assumption, not a
+/// measurement (set `locking_angle_deg` in the fabric file when it is known).
+pub const DEFAULT_LOCKING_ANGLE: f64 = 40.0 * std::f64::consts::PI / 180.0;
+
+/// KES shear values in SI, with the locking angle that bounds the trellis shear.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shear {
     /// Shear stiffness G, N/(m·rad).
@@ -29,6 +34,8 @@ pub struct Shear {
     pub hysteresis: f64,
     /// Hysteresis width 2HG5 at 5°, N/m (reports only).
     pub hysteresis_5deg: Option<f64>,
+    /// Locking angle γ_lock, rad, in (0, π/2).
+    pub locking_angle: f64,
 }
 
 impl Shear {
@@ -38,23 +45,46 @@ impl Shear {
             stiffness: units::shear_stiffness_from_kes(s.g_gf_cm_deg),
             hysteresis: units::force_from_kes(s.two_hg_gf_cm),
             hysteresis_5deg: s.two_hg5_gf_cm.map(units::force_from_kes),
+            locking_angle: s
+                .locking_angle_deg
+                .map_or(DEFAULT_LOCKING_ANGLE, f64::to_radians),
         }
     }
 
-    /// Shear angle (rad) at shear force per width `tau` (N/m) on the bilinear KES loop
-    /// `τ = Gγ ± HG`: loading from rest sticks until τ exceeds HG.
+    /// Shear angle (rad) on loading at shear force per width `tau` (N/m): the bilinear KES loop
+    /// `τ = Gγ + HG` (sticking until τ exceeds HG), saturated smoothly at the locking angle,
+    /// `γ = γ_lock·tanh(γ_lin/γ_lock)`, which keeps the slope G at small angles.
     pub fn loading_angle(&self, tau: f64) -> f64 {
-        (tau - 0.5 * self.hysteresis).max(0.0) / self.stiffness
+        self.lock((tau - 0.5 * self.hysteresis).max(0.0) / self.stiffness)
+    }
+
+    /// Shear angle on unloading from the shear force `tau_max`: the bilinear loop's falling branch
+    /// `τ = Gγ − HG`, capped at the angle reached at `tau_max`, saturated like the loading branch.
+    pub fn unloading_angle(&self, tau: f64, tau_max: f64) -> f64 {
+        let lin_max = (tau_max - 0.5 * self.hysteresis).max(0.0) / self.stiffness;
+        self.lock(((tau + 0.5 * self.hysteresis) / self.stiffness).min(lin_max))
+    }
+
+    fn lock(&self, gamma_linear: f64) -> f64 {
+        self.locking_angle * (gamma_linear / self.locking_angle).tanh()
     }
 }
 
+/// Strain along the bias of a pin-jointed (trellis) weave sheared by γ: the diagonal of a unit
+/// rhombus, `√(1 + sin γ) − 1` (≈ γ/2 for small γ).
+pub fn trellis_strain(gamma: f64) -> f64 {
+    (1.0 + gamma.sin()).sqrt() - 1.0
+}
+
 /// The bias (45°) tensile loop implied by warp, weft and shear data (`method.md` §1.4,
-/// generalised to the whole curve). Uniaxial force f along 45° puts f/2 on each yarn direction and
-/// a shear force f/2 on the weave; with ν ≈ 0 the bias strain is
-/// `ε₄₅(f) = ½ φ_v(f/2) + ½ φ_u(f/2) + ½ γ(f/2)`, which at small strain is
-/// `1/E₄₅ = ¼ (1/E_v + 1/E_u + 1/G)`. The shear angle γ follows the bilinear KES shear loop with
-/// half-width HG = 2HG/2; on unloading the yarn terms follow their minor loops from f_max/2 (thesis
-/// (40)) and γ its unloading branch, so the bias loop closes at its apex.
+/// generalised to the whole curve). Uniaxial force f along 45° puts f/2 on each yarn direction
+/// and a shear force f/2 on the weave; with ν ≈ 0 the bias strain is
+/// `ε₄₅(f) = ½ φ_v(f/2) + ½ φ_u(f/2) + s(γ(f/2))`, with s the trellis strain of the shear angle.
+/// At small strain this is `1/E₄₅ = ¼ (1/E_v + 1/E_u + 1/G)`. The shear angle follows the bilinear
+/// KES shear loop (half-width HG = 2HG/2) and saturates at the locking angle, so the bias strain
+/// stays finite (about 30 % at Fm for a 40° lock) instead of growing linearly without bound. On
+/// unloading the yarn terms follow their minor loops from f_max/2 (thesis (40)) and γ its
+/// unloading branch, so the bias loop closes at its apex.
 pub fn bias_from_shear(
     warp: &TensileLoop,
     weft: &TensileLoop,
@@ -67,17 +97,13 @@ pub fn bias_from_shear(
         s
     };
     let (turn_v, turn_u) = (turn(warp), turn(weft));
-    let hg = 0.5 * shear.hysteresis;
-    let gamma_max = shear.loading_angle(0.5 * f_max);
     TensileLoop::from_fn(f_max, |f| {
         let tau = 0.5 * f;
-        let up = warp.strain(Branch::Loading, tau)
-            + weft.strain(Branch::Loading, tau)
-            + shear.loading_angle(tau);
-        let down = turn_v.strain(warp, tau)
-            + turn_u.strain(weft, tau)
-            + ((tau + hg) / shear.stiffness).min(gamma_max);
-        (0.5 * up, 0.5 * down)
+        let up = 0.5 * (warp.strain(Branch::Loading, tau) + weft.strain(Branch::Loading, tau))
+            + trellis_strain(shear.loading_angle(tau));
+        let down = 0.5 * (turn_v.strain(warp, tau) + turn_u.strain(weft, tau))
+            + trellis_strain(shear.unloading_angle(tau, 0.5 * f_max));
+        (up, down)
     })
     .map_err(|e| e.within("shear"))
 }

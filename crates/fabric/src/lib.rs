@@ -42,7 +42,8 @@ pub use bending::{
 };
 pub use error::{ErrorKind, FileError, InvalidValue, Position};
 pub use fabric::{
-    Fabric, MAX_MONOTONE_REPAIR, MaterialTable, STANDARD_GRAVITY, Shear, bias_from_shear,
+    DEFAULT_LOCKING_ANGLE, Fabric, MAX_MONOTONE_REPAIR, MaterialTable, STANDARD_GRAVITY, Shear,
+    bias_from_shear, trellis_strain,
 };
 pub use plausibility::{FabricClass, PlausibilityWarning};
 pub use spec::FabricSpec;

@@ -267,6 +267,10 @@ pub struct ShearSpec {
     /// Hysteresis width at 5°, 2HG5, gf/cm (kept for reports and plausibility).
     #[serde(default, deserialize_with = "check::opt_non_negative")]
     pub two_hg5_gf_cm: Option<f64>,
+    /// Shear locking (jamming) angle, degrees, in (0, 90); default 40 (an assumption, see
+    /// `docs/fabric.md`).
+    #[serde(default, deserialize_with = "check::opt_locking_angle")]
+    pub locking_angle_deg: Option<f64>,
 }
 
 /// Bending data in the four directions; warp and weft are required, the biases optional.

@@ -6,8 +6,8 @@ use std::f64::consts::PI;
 use approx::assert_relative_eq;
 use atelier_fabric::anisotropy::interpolate;
 use atelier_fabric::{
-    AnisotropyForm, Branch, Directions, Fabric, MaterialTable, Shear, TensileLoop, bias_from_shear,
-    units,
+    AnisotropyForm, Branch, DEFAULT_LOCKING_ANGLE, Directions, Fabric, MaterialTable, Shear,
+    TensileLoop, bias_from_shear, trellis_strain, units,
 };
 
 use crate::common::{FIXTURES, fixture};
@@ -141,50 +141,56 @@ fn thesis_form_is_plate_theory_for_bending_rigidity() {
     }
 }
 
-/// The bias loop derived from shear has, at small force, the compliance
-/// 1/E₄₅ = ¼(1/E_v + 1/E_u + 1/G) (method §1.4), exactly for linear yarn curves and no shear
-/// hysteresis.
+/// The bias loop derived from shear: at small force its compliance is
+/// 1/E₄₅ = ¼(1/E_v + 1/E_u + 1/G) (method §1.4); at every force it is the closed form
+/// ½ε_v(f/2) + ½ε_u(f/2) + √(1 + sin γ) − 1 with γ = γ_lock·tanh(τ/(Gγ_lock)), τ = f/2; and the
+/// shear locking bounds it (no unbounded bias strain).
 #[test]
-fn bias_from_shear_has_the_small_strain_compliance() {
+fn bias_from_shear_matches_its_closed_form_and_the_small_strain_compliance() {
     let fm = units::KES_MAX_TENSILE_FORCE;
     let (ev, eu) = (2.0e4, 1.0e4);
     let shear = Shear {
         stiffness: units::shear_stiffness_from_kes(1.5),
         hysteresis: 0.0,
         hysteresis_5deg: None,
+        locking_angle: DEFAULT_LOCKING_ANGLE,
     };
-    let bias = bias_from_shear(
-        &TensileLoop::linear(ev, fm).expect("v"),
-        &TensileLoop::linear(eu, fm).expect("u"),
-        &shear,
-    )
-    .expect("bias");
-    let compliance = 0.25 * (1.0 / ev + 1.0 / eu + 1.0 / shear.stiffness);
-    for &f in &[1.0, 10.0, 200.0] {
+    let (warp, weft) = (
+        TensileLoop::linear(ev, fm).expect("v"),
+        TensileLoop::linear(eu, fm).expect("u"),
+    );
+    let bias = bias_from_shear(&warp, &weft, &shear).expect("bias");
+    let (g, lock) = (shear.stiffness, shear.locking_angle);
+    let closed = |f: f64| {
+        0.25 * f * (1.0 / ev + 1.0 / eu) + trellis_strain(lock * (0.5 * f / (g * lock)).tanh())
+    };
+    for &f in &[0.01, 1.0, 10.0, 200.0, fm] {
         assert_relative_eq!(
             bias.strain(Branch::Loading, f),
-            f * compliance,
-            max_relative = 1e-9
+            closed(f),
+            max_relative = 1e-6
         );
     }
-    // With 2HG > 0 the loop opens: unloading lies above loading and ends at a residual strain
-    // of at least HG/(2G) from the shear term.
+    let compliance = 0.25 * (1.0 / ev + 1.0 / eu + 1.0 / g);
+    assert_relative_eq!(
+        bias.strain(Branch::Loading, 0.01) / 0.01,
+        compliance,
+        max_relative = 1e-4
+    );
+    // Locked: at Fm the shear term is within 1 % of (and below) the trellis strain at the locking
+    // angle, whatever G (a linear shear term, γ/2, would give 1.45 here).
+    let shear_term = bias.apex_strain() - 0.25 * fm * (1.0 / ev + 1.0 / eu);
+    assert!(shear_term < trellis_strain(lock) && shear_term > 0.99 * trellis_strain(lock));
+    // With 2HG > 0 the loop opens: the unloading branch ends at the trellis strain of the
+    // residual shear angle HG/G, and closes at the apex.
     let hyst = Shear {
         hysteresis: units::force_from_kes(2.5),
         ..shear
     };
-    let l = bias_from_shear(
-        &TensileLoop::linear(ev, fm).expect("v"),
-        &TensileLoop::linear(eu, fm).expect("u"),
-        &hyst,
-    )
-    .expect("bias");
+    let l = bias_from_shear(&warp, &weft, &hyst).expect("bias");
     assert!(l.is_hysteretic());
-    assert_relative_eq!(
-        l.residual_strain(),
-        0.25 * hyst.hysteresis / hyst.stiffness,
-        max_relative = 1e-9
-    );
+    let residual = trellis_strain(lock * (0.5 * hyst.hysteresis / (g * lock)).tanh());
+    assert_relative_eq!(l.residual_strain(), residual, max_relative = 1e-9);
     assert_relative_eq!(
         l.strain(Branch::Unloading, fm),
         l.apex_strain(),

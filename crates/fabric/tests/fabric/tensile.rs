@@ -281,7 +281,7 @@ proptest! {
     }
 
     /// Measured-like loops (8 points per concave branch, random shapes): the minor branches (40)
-    /// alone can leave the major loop here (by up to 8.6 % of EMT in 2000 random loops, see
+    /// alone can leave the major loop here (by up to 10.1 % of EMT in 2000 random loops, see
     /// docs/fabric.md); the model clamps them to it. The strain stays inside and continuous.
     #[test]
     fn measured_loops_keep_minor_branches_inside(
