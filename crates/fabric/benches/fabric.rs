@@ -69,6 +69,22 @@ fn tensile(c: &mut Criterion) {
             sum
         })
     });
+    // Typical step: forces drift slowly and turn once per 100 steps (most updates stay on their
+    // branch).
+    let mut steady = vec![TensileState::VIRGIN; EDGES];
+    let mut step = 0usize;
+    g.bench_function("hysteresis_update_steady", |bench| {
+        bench.iter(|| {
+            step += 1;
+            let phase = (step % 200) as f64;
+            let drift = 0.002 * fm * if phase < 100.0 { phase } else { 200.0 - phase };
+            let mut sum = 0.0;
+            for (st, &f) in steady.iter_mut().zip(&a) {
+                sum += st.update(&l, black_box(0.5 * f + drift));
+            }
+            sum
+        })
+    });
     g.bench_function("hysteresis_peek", |bench| {
         bench.iter(|| {
             states
@@ -107,6 +123,20 @@ fn bending(c: &mut Criterion) {
             let mut sum = 0.0;
             for (st, &e) in states.iter_mut().zip(etas) {
                 sum += st.update(&s, black_box(e));
+            }
+            sum
+        })
+    });
+    let mut steady = vec![BendingState::VIRGIN; EDGES];
+    let mut step = 0usize;
+    g.bench_function("moment_update_steady", |bench| {
+        bench.iter(|| {
+            step += 1;
+            let phase = (step % 200) as f64;
+            let drift = 0.005 * k * if phase < 100.0 { phase } else { 200.0 - phase };
+            let mut sum = 0.0;
+            for (st, &e) in steady.iter_mut().zip(&a) {
+                sum += st.update(&s, black_box(0.5 * e + drift));
             }
             sum
         })

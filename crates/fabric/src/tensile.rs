@@ -726,7 +726,9 @@ mod tests {
                 up.push((f, eu));
                 down.push((f, ed.max(eu)));
             }
-            let Ok(l) = TensileLoop::from_measured(&up, &down) else { continue };
+            let Ok(l) = TensileLoop::from_measured(&up, &down) else {
+                continue;
+            };
             let mut st = TensileState::VIRGIN;
             for _ in 0..40 {
                 let f = uniform() * fm;

@@ -199,7 +199,10 @@ fn inconsistent_kes_values_are_rejected() {
 #[test]
 fn locking_angle_must_lie_below_ninety_degrees() {
     expect_error(
-        &mutated("two_hg_gf_cm: 2.0)", "two_hg_gf_cm: 2.0, locking_angle_deg: 95.0)"),
+        &mutated(
+            "two_hg_gf_cm: 2.0)",
+            "two_hg_gf_cm: 2.0, locking_angle_deg: 95.0)",
+        ),
         ErrorKind::OutOfRange,
         "shear.locking_angle_deg",
         14,
