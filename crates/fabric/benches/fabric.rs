@@ -30,6 +30,12 @@ fn uniform(n: usize, mut seed: u64) -> Vec<f64> {
         .collect()
 }
 
+/// A triangle wave 0 → 100 → 0 with period 200 steps: slow drift, one reversal per 100 steps.
+fn triangle(step: usize) -> f64 {
+    let phase = (step % 200) as f64;
+    if phase < 100.0 { phase } else { 200.0 - phase }
+}
+
 fn tensile(c: &mut Criterion) {
     let fabric = cotton();
     let l = fabric.tensile.warp.clone();
@@ -76,8 +82,7 @@ fn tensile(c: &mut Criterion) {
     g.bench_function("hysteresis_update_steady", |bench| {
         bench.iter(|| {
             step += 1;
-            let phase = (step % 200) as f64;
-            let drift = 0.002 * fm * if phase < 100.0 { phase } else { 200.0 - phase };
+            let drift = 0.002 * fm * triangle(step);
             let mut sum = 0.0;
             for (st, &f) in steady.iter_mut().zip(&a) {
                 sum += st.update(&l, black_box(0.5 * f + drift));
@@ -132,8 +137,7 @@ fn bending(c: &mut Criterion) {
     g.bench_function("moment_update_steady", |bench| {
         bench.iter(|| {
             step += 1;
-            let phase = (step % 200) as f64;
-            let drift = 0.005 * k * if phase < 100.0 { phase } else { 200.0 - phase };
+            let drift = 0.005 * k * triangle(step);
             let mut sum = 0.0;
             for (st, &e) in steady.iter_mut().zip(&a) {
                 sum += st.update(&s, black_box(0.5 * e + drift));

@@ -658,18 +658,22 @@ mod tests {
         assert_eq!(e.kind, ErrorKind::OutOfRange);
     }
 
+    /// A seeded uniform generator in [0, 1) (xorshift64).
+    fn xorshift(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// The minor-loop formula (40) itself, without the envelope clamp, stays inside the major
     /// loop for synthetic loops (LT 0.5–0.9, RT 30–80 %, EMT 1–15 %): 2000 random reversal
     /// sequences of 40 forces (`method.md` §1.1 reports the same for its check).
     #[test]
     fn unclamped_minor_loops_stay_inside_synthetic_loops() {
-        let mut seed: u64 = 0x1234_5678;
-        let mut uniform = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = xorshift(0x1234_5678);
         for _ in 0..2000 {
             let s = TensileSummary {
                 lt: 0.5 + 0.4 * uniform(),
@@ -699,13 +703,7 @@ mod tests {
     /// callers see, stays inside (integration test `measured_loops_keep_minor_branches_inside`).
     #[test]
     fn unclamped_minor_loops_can_leave_measured_loops() {
-        let mut seed: u64 = 7;
-        let mut uniform = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = xorshift(7);
         let mut worst: f64 = 0.0;
         for _ in 0..2000 {
             let (fm, emt) = (490.0, 0.02 + 0.1 * uniform());
