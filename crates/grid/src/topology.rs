@@ -1,0 +1,635 @@
+//! The cooked, immutable cloth topology the solver consumes (thesis §3.4, `method.md` §0 and §4):
+//! nodes with rest positions in the pattern plane, axial (4-neighbourhood) and diagonal edges
+//! (together the 8-neighbourhood) with rest length and material angle, triangles, node areas,
+//! and the incidence lists the solver gathers over.
+//!
+//! Conventions: grid axes u (first index) and v (second index) are topological; the *material*
+//! angle of an edge is measured in the pattern plane from the warp (grain) direction, in [0, π).
+//! Triangles are counter-clockwise in the pattern plane, so a sheet's normal is the pattern
+//! plane's +z wherever the cloth is placed flat.
+
+use std::f64::consts::PI;
+
+/// Marks an absent neighbour.
+pub const NO_NODE: u32 = u32::MAX;
+
+/// What an edge connects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EdgeKind {
+    /// Along the grid's u axis (4-neighbourhood).
+    AxialU,
+    /// Along the grid's v axis (4-neighbourhood).
+    AxialV,
+    /// Across a cell (the diagonals of the 8-neighbourhood).
+    Diagonal,
+}
+
+impl EdgeKind {
+    /// Whether the edge belongs to the 4-neighbourhood.
+    pub fn is_axial(self) -> bool {
+        !matches!(self, EdgeKind::Diagonal)
+    }
+}
+
+/// One edge of the 8-neighbourhood.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Edge {
+    /// First node.
+    pub a: u32,
+    /// Second node.
+    pub b: u32,
+    /// Axial (u or v) or diagonal.
+    pub kind: EdgeKind,
+    /// Rest length l⁰ in the pattern plane, m.
+    pub rest_length: f64,
+    /// Material angle θ from the warp, rad, in [0, π).
+    pub material_angle: f64,
+}
+
+/// One grid cell (a quadrilateral `q0 q1 q2 q3`, u from q0 to q1, v from q0 to q3) with its
+/// edges: the diagonals `q0–q2` ("plus") and `q1–q3` ("minus") belong to it alone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cell {
+    /// Corner nodes.
+    pub nodes: [u32; 4],
+    /// The u edges `q0–q1` and `q3–q2`.
+    pub u_edges: [u32; 2],
+    /// The v edges `q0–q3` and `q1–q2`.
+    pub v_edges: [u32; 2],
+    /// The diagonals `q0–q2` and `q1–q3`.
+    pub diagonals: [u32; 2],
+    /// Rest angle between the u and v sides at the cell's centre (mean of the corner angles of
+    /// the parallelogram through the side midpoints), rad.
+    pub rest_angle: f64,
+    /// Rest area, m².
+    pub area: f64,
+}
+
+/// The axial neighbour slots of a node: +u, −u, +v, −v.
+pub const SLOTS: usize = 4;
+
+/// A structured grid of `nu × nv` nodes in the pattern plane (node `(i, j)` at index
+/// `j·nu + i`), optionally closed in u (an annulus: node `(nu, j)` is node `(0, j)`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StructuredGrid {
+    /// Nodes along u.
+    pub nu: usize,
+    /// Nodes along v.
+    pub nv: usize,
+    /// Whether u wraps around.
+    pub periodic_u: bool,
+    /// Pattern-plane positions, m, `nu·nv` of them.
+    pub positions: Vec<[f64; 2]>,
+    /// Warp (grain) direction as an angle from the pattern x axis, rad.
+    pub grain_angle: f64,
+}
+
+impl StructuredGrid {
+    /// A rectangle `width × height` (m) with `nu × nv` nodes, u along x, v along y, the warp
+    /// along y (so AxialV edges are warp, θ = 0, and AxialU edges weft, θ = 90°).
+    pub fn sheet(nu: usize, nv: usize, width: f64, height: f64) -> Self {
+        let positions = (0..nv)
+            .flat_map(|j| {
+                (0..nu).map(move |i| {
+                    [
+                        width * i as f64 / (nu.max(2) - 1) as f64,
+                        height * j as f64 / (nv.max(2) - 1) as f64,
+                    ]
+                })
+            })
+            .collect();
+        Self {
+            nu,
+            nv,
+            periodic_u: false,
+            positions,
+            grain_angle: PI / 2.0,
+        }
+    }
+
+    /// An annulus (the drape-test disk with its support hole) centred at the origin: `n_around`
+    /// nodes per ring (u, periodic), `n_rings` rings (v) from `r_inner` to `r_outer` (m), the warp
+    /// along y.
+    pub fn annulus(n_around: usize, n_rings: usize, r_inner: f64, r_outer: f64) -> Self {
+        let positions = (0..n_rings)
+            .flat_map(|j| {
+                let r = r_inner + (r_outer - r_inner) * j as f64 / (n_rings.max(2) - 1) as f64;
+                (0..n_around).map(move |i| {
+                    let psi = 2.0 * PI * i as f64 / n_around as f64;
+                    [r * psi.cos(), r * psi.sin()]
+                })
+            })
+            .collect();
+        Self {
+            nu: n_around,
+            nv: n_rings,
+            periodic_u: true,
+            positions,
+            grain_angle: PI / 2.0,
+        }
+    }
+
+    /// Index of node `(i, j)`; `i` wraps when the grid is periodic.
+    pub fn index(&self, i: usize, j: usize) -> usize {
+        j * self.nu + if self.periodic_u { i % self.nu } else { i }
+    }
+}
+
+/// Why a grid cannot be turned into a topology.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum TopologyError {
+    /// Too few nodes in a direction.
+    #[error(
+        "a grid needs at least 2 nodes along v and 2 (3 when periodic) along u, got {nu} × {nv}"
+    )]
+    TooSmall {
+        /// Nodes along u.
+        nu: usize,
+        /// Nodes along v.
+        nv: usize,
+    },
+    /// The position list does not have `nu·nv` entries.
+    #[error("expected {expected} positions, got {found}")]
+    PositionCount {
+        /// `nu·nv`.
+        expected: usize,
+        /// Given.
+        found: usize,
+    },
+    /// A non-finite coordinate.
+    #[error("node {node} has a non-finite position ({x}, {y})")]
+    NotFinite {
+        /// Node index.
+        node: usize,
+        /// x.
+        x: f64,
+        /// y.
+        y: f64,
+    },
+    /// Two nodes of an edge coincide.
+    #[error("edge {a}–{b} has zero length")]
+    ZeroLength {
+        /// Node.
+        a: u32,
+        /// Node.
+        b: u32,
+    },
+    /// A cell is degenerate or folded against the others.
+    #[error("cell at ({i}, {j}) is degenerate or inverted (signed area {area})")]
+    BadCell {
+        /// u index.
+        i: usize,
+        /// v index.
+        j: usize,
+        /// Its signed area relative to the grid's orientation, m².
+        area: f64,
+    },
+}
+
+/// The cloth topology: immutable, shared by every state of the same garment.
+#[derive(Clone, Debug)]
+pub struct ClothTopology {
+    rest: Vec<[f64; 2]>,
+    edges: Vec<Edge>,
+    axial: Vec<[u32; SLOTS]>,
+    axial_edge: Vec<[u32; SLOTS]>,
+    triangles: Vec<[u32; 3]>,
+    node_area: Vec<f64>,
+    incidence_offsets: Vec<u32>,
+    incidence: Vec<u32>,
+    tri_offsets: Vec<u32>,
+    tri_incidence: Vec<u32>,
+    cells: Vec<Cell>,
+    edge_cells: Vec<[u32; 2]>,
+    grid: Option<(usize, usize, bool)>,
+}
+
+impl ClothTopology {
+    /// Cook a structured grid: axial edges along u and v, both diagonals of every cell,
+    /// two triangles per cell (the split alternates in a checkerboard so no direction is
+    /// favoured), node areas as a quarter of each incident cell.
+    pub fn from_structured(g: &StructuredGrid) -> Result<Self, TopologyError> {
+        let (nu, nv) = (g.nu, g.nv);
+        if nv < 2 || nu < 2 || (g.periodic_u && nu < 3) {
+            return Err(TopologyError::TooSmall { nu, nv });
+        }
+        if g.positions.len() != nu * nv {
+            return Err(TopologyError::PositionCount {
+                expected: nu * nv,
+                found: g.positions.len(),
+            });
+        }
+        if let Some((node, p)) = g
+            .positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(TopologyError::NotFinite {
+                node,
+                x: p[0],
+                y: p[1],
+            });
+        }
+        let n = nu * nv;
+        let cells_u = if g.periodic_u { nu } else { nu - 1 };
+        let grain = [g.grain_angle.cos(), g.grain_angle.sin()];
+        let mut topo = Self {
+            rest: g.positions.clone(),
+            edges: Vec::new(),
+            axial: vec![[NO_NODE; SLOTS]; n],
+            axial_edge: vec![[NO_NODE; SLOTS]; n],
+            triangles: Vec::with_capacity(2 * cells_u * (nv - 1)),
+            node_area: vec![0.0; n],
+            incidence_offsets: Vec::new(),
+            incidence: Vec::new(),
+            tri_offsets: Vec::new(),
+            tri_incidence: Vec::new(),
+            cells: Vec::new(),
+            edge_cells: Vec::new(),
+            grid: Some((nu, nv, g.periodic_u)),
+        };
+        let add_edge =
+            |topo: &mut Self, a: usize, b: usize, kind: EdgeKind| -> Result<u32, TopologyError> {
+                let (pa, pb) = (g.positions[a], g.positions[b]);
+                let e = [pb[0] - pa[0], pb[1] - pa[1]];
+                let len = e[0].hypot(e[1]);
+                if len <= 0.0 {
+                    return Err(TopologyError::ZeroLength {
+                        a: a as u32,
+                        b: b as u32,
+                    });
+                }
+                let cross = grain[0] * e[1] - grain[1] * e[0];
+                let dot = grain[0] * e[0] + grain[1] * e[1];
+                let mut angle = cross.atan2(dot).rem_euclid(PI);
+                if angle >= PI {
+                    angle = 0.0;
+                }
+                topo.edges.push(Edge {
+                    a: a as u32,
+                    b: b as u32,
+                    kind,
+                    rest_length: len,
+                    material_angle: angle,
+                });
+                Ok((topo.edges.len() - 1) as u32)
+            };
+        // Axial edges and their slots.
+        let mut u_edge = vec![NO_NODE; cells_u * nv];
+        let mut v_edge = vec![NO_NODE; nu * (nv - 1)];
+        for j in 0..nv {
+            for i in 0..cells_u {
+                let (a, b) = (g.index(i, j), g.index(i + 1, j));
+                let e = add_edge(&mut topo, a, b, EdgeKind::AxialU)?;
+                u_edge[j * cells_u + i] = e;
+                topo.axial[a][0] = b as u32;
+                topo.axial_edge[a][0] = e;
+                topo.axial[b][1] = a as u32;
+                topo.axial_edge[b][1] = e;
+            }
+        }
+        for j in 0..nv - 1 {
+            for i in 0..nu {
+                let (a, b) = (g.index(i, j), g.index(i, j + 1));
+                let e = add_edge(&mut topo, a, b, EdgeKind::AxialV)?;
+                v_edge[j * nu + i] = e;
+                topo.axial[a][2] = b as u32;
+                topo.axial_edge[a][2] = e;
+                topo.axial[b][3] = a as u32;
+                topo.axial_edge[b][3] = e;
+            }
+        }
+        // Cells: orientation from the first cell, diagonals, triangles, areas.
+        let signed_area = |q: [usize; 4]| -> f64 {
+            let p = q.map(|k| g.positions[k]);
+            0.5 * (0..4)
+                .map(|k| {
+                    let (a, b) = (p[k], p[(k + 1) % 4]);
+                    a[0] * b[1] - b[0] * a[1]
+                })
+                .sum::<f64>()
+        };
+        let quad = |i: usize, j: usize| {
+            [
+                g.index(i, j),
+                g.index(i + 1, j),
+                g.index(i + 1, j + 1),
+                g.index(i, j + 1),
+            ]
+        };
+        let orientation = signed_area(quad(0, 0)).signum();
+        for j in 0..nv - 1 {
+            for i in 0..cells_u {
+                let q = quad(i, j);
+                let area = signed_area(q) * orientation;
+                if area.is_nan() || area <= 0.0 {
+                    return Err(TopologyError::BadCell { i, j, area });
+                }
+                let plus = add_edge(&mut topo, q[0], q[2], EdgeKind::Diagonal)?;
+                let minus = add_edge(&mut topo, q[1], q[3], EdgeKind::Diagonal)?;
+                let p = q.map(|k| g.positions[k]);
+                let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+                let su = {
+                    let (m0, m1) = (mid(p[0], p[3]), mid(p[1], p[2]));
+                    [m1[0] - m0[0], m1[1] - m0[1]]
+                };
+                let sv = {
+                    let (m0, m1) = (mid(p[0], p[1]), mid(p[3], p[2]));
+                    [m1[0] - m0[0], m1[1] - m0[1]]
+                };
+                let rest_angle = (su[0] * sv[1] - su[1] * sv[0])
+                    .abs()
+                    .atan2(su[0] * sv[0] + su[1] * sv[1]);
+                let next_i = if g.periodic_u { (i + 1) % nu } else { i + 1 };
+                topo.cells.push(Cell {
+                    nodes: q.map(|k| k as u32),
+                    u_edges: [u_edge[j * cells_u + i], u_edge[(j + 1) * cells_u + i]],
+                    v_edges: [v_edge[j * nu + i], v_edge[j * nu + next_i]],
+                    diagonals: [plus, minus],
+                    rest_angle,
+                    area,
+                });
+                // Counter-clockwise in the pattern plane.
+                let ccw = |t: [usize; 3]| -> [u32; 3] {
+                    let t = if orientation > 0.0 {
+                        t
+                    } else {
+                        [t[0], t[2], t[1]]
+                    };
+                    t.map(|k| k as u32)
+                };
+                if (i + j) % 2 == 0 {
+                    topo.triangles.push(ccw([q[0], q[1], q[2]]));
+                    topo.triangles.push(ccw([q[0], q[2], q[3]]));
+                } else {
+                    topo.triangles.push(ccw([q[0], q[1], q[3]]));
+                    topo.triangles.push(ccw([q[1], q[2], q[3]]));
+                }
+                for k in q {
+                    topo.node_area[k] += 0.25 * area;
+                }
+            }
+        }
+        topo.build_incidence();
+        Ok(topo)
+    }
+
+    /// CSR lists: for each node, the edges (and triangles) touching it; for each edge, its cells.
+    fn build_incidence(&mut self) {
+        let n = self.rest.len();
+        let (offsets, list) = csr(n, self.edges.iter().map(|e| [e.a, e.b]));
+        self.incidence_offsets = offsets;
+        self.incidence = list;
+        let (offsets, list) = csr(n, self.triangles.iter().copied());
+        self.tri_offsets = offsets;
+        self.tri_incidence = list;
+        self.edge_cells = vec![[NO_NODE; 2]; self.edges.len()];
+        for (ci, c) in self.cells.iter().enumerate() {
+            for e in c.u_edges.iter().chain(&c.v_edges).chain(&c.diagonals) {
+                let slot = &mut self.edge_cells[*e as usize];
+                let k = usize::from(slot[0] != NO_NODE);
+                slot[k] = ci as u32;
+            }
+        }
+    }
+
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.rest.len()
+    }
+
+    /// Rest positions in the pattern plane, m.
+    pub fn rest_positions(&self) -> &[[f64; 2]] {
+        &self.rest
+    }
+
+    /// All edges (axial and diagonal).
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+
+    /// Axial neighbours of each node per slot (+u, −u, +v, −v); [`NO_NODE`] where absent.
+    pub fn axial_neighbours(&self) -> &[[u32; SLOTS]] {
+        &self.axial
+    }
+
+    /// The edge index of each axial slot; [`NO_NODE`] where absent.
+    pub fn axial_edges(&self) -> &[[u32; SLOTS]] {
+        &self.axial_edge
+    }
+
+    /// Triangles, counter-clockwise in the pattern plane.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Area each node represents (S), m²: a quarter of every incident cell.
+    pub fn node_areas(&self) -> &[f64] {
+        &self.node_area
+    }
+
+    /// Total pattern area, m².
+    pub fn area(&self) -> f64 {
+        self.node_area.iter().sum()
+    }
+
+    /// Edges incident to `node`.
+    pub fn incident_edges(&self, node: usize) -> &[u32] {
+        let (a, b) = (
+            self.incidence_offsets[node] as usize,
+            self.incidence_offsets[node + 1] as usize,
+        );
+        &self.incidence[a..b]
+    }
+
+    /// Triangles incident to `node`.
+    pub fn incident_triangles(&self, node: usize) -> &[u32] {
+        let (a, b) = (
+            self.tri_offsets[node] as usize,
+            self.tri_offsets[node + 1] as usize,
+        );
+        &self.tri_incidence[a..b]
+    }
+
+    /// The grid cells.
+    pub fn cells(&self) -> &[Cell] {
+        &self.cells
+    }
+
+    /// The (up to two) cells each edge borders; [`NO_NODE`] where absent. A diagonal has one.
+    pub fn edge_cells(&self) -> &[[u32; 2]] {
+        &self.edge_cells
+    }
+
+    /// `(nu, nv, periodic_u)` of the structured grid this came from.
+    pub fn grid_shape(&self) -> Option<(usize, usize, bool)> {
+        self.grid
+    }
+
+    /// Greedy edge colouring: groups of edges that share no node, so a colour can be processed
+    /// in parallel without conflicts. Deterministic (edges in index order).
+    pub fn edge_colours(&self) -> Vec<Vec<u32>> {
+        let n = self.rest.len();
+        let mut used: Vec<u64> = vec![0; n];
+        let mut colours: Vec<Vec<u32>> = Vec::new();
+        for (ei, e) in self.edges.iter().enumerate() {
+            let busy = used[e.a as usize] | used[e.b as usize];
+            let c = (!busy).trailing_zeros() as usize;
+            if c >= colours.len() {
+                colours.resize_with(c + 1, Vec::new);
+            }
+            colours[c].push(ei as u32);
+            used[e.a as usize] |= 1 << c;
+            used[e.b as usize] |= 1 << c;
+        }
+        colours
+    }
+}
+
+/// Compressed lists of the items touching each of `n` nodes, in item order.
+fn csr<const K: usize>(
+    n: usize,
+    items: impl Iterator<Item = [u32; K]> + Clone,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut offsets = vec![0u32; n + 1];
+    for item in items.clone() {
+        for v in item {
+            offsets[v as usize + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        offsets[k + 1] += offsets[k];
+    }
+    let mut fill = offsets.clone();
+    let mut list = vec![0u32; offsets[n] as usize];
+    for (idx, item) in items.enumerate() {
+        for v in item {
+            list[fill[v as usize] as usize] = idx as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    (offsets, list)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn sheet_counts_areas_and_angles() {
+        let t =
+            ClothTopology::from_structured(&StructuredGrid::sheet(4, 3, 0.3, 0.2)).expect("valid");
+        assert_eq!(t.node_count(), 12);
+        // Axial: 3·3 along u + 4·2 along v; diagonals: 2 per cell, 3·2 cells.
+        assert_eq!(t.edges().len(), 9 + 8 + 12);
+        assert_eq!(t.triangles().len(), 12);
+        assert_relative_eq!(t.area(), 0.06, max_relative = 1e-12);
+        // Interior node area h_u·h_v = 0.1·0.1, corner a quarter of it.
+        assert_relative_eq!(t.node_areas()[5], 0.01, max_relative = 1e-12);
+        assert_relative_eq!(t.node_areas()[0], 0.0025, max_relative = 1e-12);
+        for e in t.edges() {
+            let expect = match e.kind {
+                EdgeKind::AxialV => 0.0,
+                EdgeKind::AxialU => PI / 2.0,
+                EdgeKind::Diagonal => {
+                    assert!(
+                        (e.material_angle - PI / 4.0).abs() < 1e-12
+                            || (e.material_angle - 3.0 * PI / 4.0).abs() < 1e-12
+                    );
+                    continue;
+                }
+            };
+            assert_relative_eq!(e.material_angle, expect, epsilon = 1e-12);
+        }
+        // Triangles counter-clockwise.
+        for tri in t.triangles() {
+            let p = tri.map(|k| t.rest_positions()[k as usize]);
+            let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+            assert!(area > 0.0);
+        }
+    }
+
+    #[test]
+    fn annulus_wraps_and_keeps_orientation() {
+        let t = ClothTopology::from_structured(&StructuredGrid::annulus(60, 6, 0.0635, 0.3175))
+            .expect("valid");
+        assert_eq!(t.node_count(), 360);
+        // Every node has both u neighbours.
+        assert!(
+            t.axial_neighbours()
+                .iter()
+                .all(|s| s[0] != NO_NODE && s[1] != NO_NODE)
+        );
+        let exact = PI * (0.3175f64.powi(2) - 0.0635f64.powi(2));
+        // Polygonal rings: area within 0.2 % of the circle annulus for 60 sectors.
+        assert_relative_eq!(t.area(), exact, max_relative = 2e-3);
+        for tri in t.triangles() {
+            let p = tri.map(|k| t.rest_positions()[k as usize]);
+            let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+            assert!(area > 0.0);
+        }
+    }
+
+    #[test]
+    fn colours_share_no_node_and_incidence_is_complete() {
+        let t =
+            ClothTopology::from_structured(&StructuredGrid::sheet(7, 5, 0.6, 0.4)).expect("valid");
+        let colours = t.edge_colours();
+        let mut seen = 0;
+        for c in &colours {
+            let mut nodes = std::collections::HashSet::new();
+            for &e in c {
+                let e = t.edges()[e as usize];
+                assert!(nodes.insert(e.a) && nodes.insert(e.b));
+            }
+            seen += c.len();
+        }
+        assert_eq!(seen, t.edges().len());
+        assert!(colours.len() <= 10, "{} colours", colours.len());
+        let total: usize = (0..t.node_count()).map(|i| t.incident_edges(i).len()).sum();
+        assert_eq!(total, 2 * t.edges().len());
+        let total: usize = (0..t.node_count())
+            .map(|i| t.incident_triangles(i).len())
+            .sum();
+        assert_eq!(total, 3 * t.triangles().len());
+        // Every diagonal borders one cell, every interior axial edge two.
+        for (e, cells) in t.edges().iter().zip(t.edge_cells()) {
+            let count = cells.iter().filter(|&&c| c != NO_NODE).count();
+            match e.kind {
+                EdgeKind::Diagonal => assert_eq!(count, 1),
+                _ => assert!(count == 1 || count == 2),
+            }
+        }
+        for c in t.cells() {
+            assert!((c.rest_angle - PI / 2.0).abs() < 1e-12);
+            assert!((c.area - 0.01).abs() < 1e-12);
+            let d = t.edges()[c.diagonals[0] as usize];
+            assert_eq!([d.a, d.b], [c.nodes[0], c.nodes[2]]);
+        }
+        assert_eq!(t.incident_edges(8 + 7).len(), 8);
+    }
+
+    #[test]
+    fn bad_grids_are_rejected() {
+        let mut g = StructuredGrid::sheet(3, 3, 1.0, 1.0);
+        g.positions[4] = [f64::NAN, 0.0];
+        assert!(matches!(
+            ClothTopology::from_structured(&g),
+            Err(TopologyError::NotFinite { node: 4, .. })
+        ));
+        let mut g = StructuredGrid::sheet(3, 3, 1.0, 1.0);
+        g.positions[4] = [3.0, 3.0];
+        assert!(matches!(
+            ClothTopology::from_structured(&g),
+            Err(TopologyError::BadCell { .. })
+        ));
+        assert!(matches!(
+            ClothTopology::from_structured(&StructuredGrid::sheet(1, 3, 1.0, 1.0)),
+            Err(TopologyError::TooSmall { .. })
+        ));
+    }
+}

@@ -1,0 +1,313 @@
+//! The static description of one piece of cloth for the solver: its topology, the fabric's
+//! characteristics at every edge angle, node masses, and pins (inverse mass 0, fixed or moving).
+
+use atelier_fabric::{AnisotropyForm, Fabric, InvalidValue, MaterialTable};
+use atelier_grid::{ClothTopology, EdgeKind, NO_NODE, SLOTS};
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use crate::shear::ShearCurve;
+
+/// How a pinned node moves (its position is prescribed; the solver never moves it otherwise).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum PinMotion {
+    /// Held at its anchor.
+    Fixed,
+    /// Moving at a constant velocity (m/s) from its anchor, starting at time 0.
+    Velocity([f64; 3]),
+    /// `anchor + amplitude · sin(2π f t)`.
+    Oscillate {
+        /// m.
+        amplitude: [f64; 3],
+        /// Hz.
+        frequency: f64,
+    },
+}
+
+/// A pinned node.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pin {
+    /// Node index.
+    pub node: u32,
+    /// Position at time 0, m.
+    pub anchor: Vector3<f64>,
+    /// Prescribed motion.
+    pub motion: PinMotion,
+}
+
+impl Pin {
+    /// Prescribed position at time `t`.
+    pub fn position(&self, t: f64) -> Vector3<f64> {
+        match self.motion {
+            PinMotion::Fixed => self.anchor,
+            PinMotion::Velocity(v) => self.anchor + Vector3::from(v) * t,
+            PinMotion::Oscillate {
+                amplitude,
+                frequency,
+            } => {
+                self.anchor
+                    + Vector3::from(amplitude) * (2.0 * std::f64::consts::PI * frequency * t).sin()
+            }
+        }
+    }
+}
+
+/// Why a cloth cannot be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ClothError {
+    /// The fabric's characteristics cannot be interpolated to an edge angle.
+    #[error("fabric `{fabric}`: {source}")]
+    Material {
+        /// Fabric name.
+        fabric: String,
+        /// What failed.
+        #[source]
+        source: InvalidValue,
+    },
+    /// A pin names a node that does not exist.
+    #[error("pin on node {node}, but the cloth has {nodes} nodes")]
+    NoSuchNode {
+        /// Requested node.
+        node: u32,
+        /// Node count.
+        nodes: usize,
+    },
+    /// A pin anchor or motion is not finite.
+    #[error("pin on node {node} has a non-finite anchor or motion")]
+    NotFinite {
+        /// Node.
+        node: u32,
+    },
+}
+
+/// One piece of cloth: topology, materials, masses and pins. Immutable during a simulation
+/// (pins are set before the first step).
+#[derive(Clone, Debug)]
+pub struct Cloth {
+    topology: ClothTopology,
+    fabric: Fabric,
+    form: AnisotropyForm,
+    materials: MaterialTable,
+    edge_material: Vec<u32>,
+    slot_material: Vec<[u32; SLOTS]>,
+    edge_width: Vec<f64>,
+    colours: usize,
+    colour_edge: Vec<u32>,
+    axial_list: Vec<u32>,
+    diagonal_list: Vec<u32>,
+    shear: ShearCurve,
+    mass: Vec<f64>,
+    inv_mass: Vec<f64>,
+    pins: Vec<Pin>,
+    pin_of: Vec<u32>,
+}
+
+impl Cloth {
+    /// Build a cloth from a topology and a fabric, interpolating the fabric to every distinct
+    /// edge angle once.
+    pub fn new(
+        topology: ClothTopology,
+        fabric: &Fabric,
+        form: AnisotropyForm,
+    ) -> Result<Self, ClothError> {
+        let angles: Vec<f64> = topology.edges().iter().map(|e| e.material_angle).collect();
+        let (materials, edge_material) =
+            MaterialTable::build(fabric, form, &angles).map_err(|source| ClothError::Material {
+                fabric: fabric.name.clone(),
+                source,
+            })?;
+        let slot_material = topology
+            .axial_edges()
+            .iter()
+            .map(|slots| {
+                slots.map(|e| {
+                    if e == NO_NODE {
+                        NO_NODE
+                    } else {
+                        edge_material[e as usize]
+                    }
+                })
+            })
+            .collect();
+        let mass: Vec<f64> = topology
+            .node_areas()
+            .iter()
+            .map(|s| s * fabric.mass_per_area)
+            .collect();
+        let inv_mass = mass.iter().map(|m| 1.0 / m).collect();
+        let n = topology.node_count();
+        // Width an axial edge carries: half of each cell on either side, area / length.
+        let mut edge_width = vec![0.0; topology.edges().len()];
+        for (w, (e, cells)) in edge_width
+            .iter_mut()
+            .zip(topology.edges().iter().zip(topology.edge_cells()))
+        {
+            let area: f64 = cells
+                .iter()
+                .filter(|&&c| c != NO_NODE)
+                .map(|&c| topology.cells()[c as usize].area)
+                .sum();
+            *w = 0.5 * area / e.rest_length;
+        }
+        let colouring = topology.edge_colours();
+        let colours = colouring.len();
+        let mut colour_edge = vec![NO_NODE; n * colours];
+        for (c, list) in colouring.iter().enumerate() {
+            for &e in list {
+                let edge = topology.edges()[e as usize];
+                colour_edge[edge.a as usize * colours + c] = e;
+                colour_edge[edge.b as usize * colours + c] = e;
+            }
+        }
+        let (axial_list, diagonal_list): (Vec<u32>, Vec<u32>) = (0..topology.edges().len() as u32)
+            .partition(|&e| topology.edges()[e as usize].kind != EdgeKind::Diagonal);
+        Ok(Self {
+            shear: ShearCurve::from_fabric(fabric),
+            topology,
+            fabric: fabric.clone(),
+            form,
+            materials,
+            edge_material,
+            slot_material,
+            edge_width,
+            colours,
+            colour_edge,
+            axial_list,
+            diagonal_list,
+            mass,
+            inv_mass,
+            pins: Vec::new(),
+            pin_of: vec![NO_NODE; n],
+        })
+    }
+
+    /// Pin `node` at `anchor` with `motion` (re-pinning a node replaces its pin).
+    pub fn pin(
+        &mut self,
+        node: u32,
+        anchor: Vector3<f64>,
+        motion: PinMotion,
+    ) -> Result<(), ClothError> {
+        let n = self.topology.node_count();
+        if node as usize >= n {
+            return Err(ClothError::NoSuchNode { node, nodes: n });
+        }
+        let finite = match motion {
+            PinMotion::Fixed => true,
+            PinMotion::Velocity(v) => v.iter().all(|x| x.is_finite()),
+            PinMotion::Oscillate {
+                amplitude,
+                frequency,
+            } => amplitude.iter().all(|x| x.is_finite()) && frequency.is_finite(),
+        };
+        if !(finite && anchor.iter().all(|x| x.is_finite())) {
+            return Err(ClothError::NotFinite { node });
+        }
+        let pin = Pin {
+            node,
+            anchor,
+            motion,
+        };
+        match self.pin_of[node as usize] {
+            NO_NODE => {
+                self.pin_of[node as usize] = self.pins.len() as u32;
+                self.pins.push(pin);
+            }
+            k => self.pins[k as usize] = pin,
+        }
+        self.inv_mass[node as usize] = 0.0;
+        Ok(())
+    }
+
+    /// The topology.
+    pub fn topology(&self) -> &ClothTopology {
+        &self.topology
+    }
+
+    /// The fabric.
+    pub fn fabric(&self) -> &Fabric {
+        &self.fabric
+    }
+
+    /// The anisotropy form the materials were interpolated with.
+    pub fn anisotropy_form(&self) -> AnisotropyForm {
+        self.form
+    }
+
+    /// The per-angle material table.
+    pub fn materials(&self) -> &MaterialTable {
+        &self.materials
+    }
+
+    /// Material entry of each edge.
+    pub fn edge_materials(&self) -> &[u32] {
+        &self.edge_material
+    }
+
+    /// Material entry of each node's axial slots (the bending characteristic at that edge's
+    /// angle); [`NO_NODE`] where the slot is empty.
+    pub fn slot_materials(&self) -> &[[u32; SLOTS]] {
+        &self.slot_material
+    }
+
+    /// Width each axial edge carries (half the cells beside it, area over length), m; the
+    /// force per width of an edge is p/W.
+    pub fn edge_widths(&self) -> &[f64] {
+        &self.edge_width
+    }
+
+    /// Number of edge colours (groups of edges sharing no node).
+    pub fn colour_count(&self) -> usize {
+        self.colours
+    }
+
+    /// The edge of colour `colour` at `node`, if any ([`NO_NODE`] otherwise).
+    pub fn colour_edge(&self, node: usize, colour: usize) -> u32 {
+        self.colour_edge[node * self.colours + colour]
+    }
+
+    /// Indices of the axial edges.
+    pub fn axial_edge_list(&self) -> &[u32] {
+        &self.axial_list
+    }
+
+    /// Indices of the diagonal edges.
+    pub fn diagonal_edge_list(&self) -> &[u32] {
+        &self.diagonal_list
+    }
+
+    /// The in-plane shear characteristic of the cells.
+    pub fn shear_curve(&self) -> &ShearCurve {
+        &self.shear
+    }
+
+    /// Node masses μ = m_A·S, kg.
+    pub fn masses(&self) -> &[f64] {
+        &self.mass
+    }
+
+    /// Inverse masses; 0 for pinned nodes.
+    pub fn inverse_masses(&self) -> &[f64] {
+        &self.inv_mass
+    }
+
+    /// Pins.
+    pub fn pins(&self) -> &[Pin] {
+        &self.pins
+    }
+
+    /// Whether `node` is pinned.
+    pub fn is_pinned(&self, node: usize) -> bool {
+        self.pin_of[node] != NO_NODE
+    }
+
+    /// Whether any edge's tensile loop has hysteresis.
+    pub fn tensile_hysteretic(&self) -> bool {
+        (0..self.materials.len() as u32).any(|i| self.materials.tensile(i).is_hysteretic())
+    }
+
+    /// Whether any bending characteristic has hysteresis.
+    pub fn bending_hysteretic(&self) -> bool {
+        (0..self.materials.len() as u32).any(|i| self.materials.bending(i).is_hysteretic())
+    }
+}

@@ -1,0 +1,27 @@
+//! # atelier-solver
+//!
+//! The PARTY cloth model (Sakaguchi's thesis §3.5 and §3.8; `method.md` §2): a constraint-
+//! satisfaction step in which measured tensile characteristics fix the lengths of the grid's
+//! edges at the forces they carry, and measured bending characteristics give forces along the
+//! surface normal. See `docs/solver.md` for the stages, their equations and every choice made
+//! where the thesis is silent.
+//!
+//! - [`Cloth`]: topology + fabric + masses + pins (static);
+//! - [`ClothState`]: positions, velocities, warm-start forces, hysteresis states;
+//! - [`Solver::step`]: one step, with [`StepParams`] and a [`StepReport`] of diagnostics.
+
+pub mod cloth;
+pub mod params;
+pub mod shear;
+pub mod state;
+pub mod step;
+
+pub use cloth::{Cloth, ClothError, Pin, PinMotion};
+pub use params::{
+    ConstraintKind, InternalMethod, ParamError, ShapeMethod, StepParams, TolerancePolicy,
+};
+pub use shear::ShearCurve;
+pub use state::ClothState;
+pub use step::{
+    CollisionHook, HookContext, NoCollision, Solver, Stage, StageTimings, StepError, StepReport,
+};

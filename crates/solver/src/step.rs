@@ -1,0 +1,1236 @@
+//! The PARTY cloth step (thesis §3.5, §3.8; `method.md` §2) as an ordered list of stages, each a
+//! function of its own, each timed:
+//!
+//! 1. geometry and bending force (28)–(32);
+//! 2. internal axial forces p ≥ 0 by projected descent (43)–(47), axial edges then diagonals;
+//! 3. unconstrained velocity (18);
+//! 4. shape-constraint targets from the tensile and shear characteristics, and the constraint
+//!    iterations (49)–(51), interleaved with collision passes;
+//! 5. position update, hysteresis update, diagnostics.
+//!
+//! Nothing in the state changes until every stage has succeeded: a non-finite value stops the
+//! step with the stage and node (or edge), and the state from before the step is kept.
+
+use std::time::{Duration, Instant};
+
+use atelier_fabric::Branch;
+use atelier_grid::{NO_NODE, SLOTS};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+use crate::cloth::Cloth;
+use crate::params::{ConstraintKind, InternalMethod, ParamError, ShapeMethod, StepParams};
+use crate::state::ClothState;
+
+type V3 = Vector3<f64>;
+
+/// Below this many items a loop runs on one thread (rayon's overhead would dominate).
+const PAR_MIN: usize = 4096;
+/// Chunk size of the deterministic reductions (fixed, so sums do not depend on thread count).
+const SUM_CHUNK: usize = 2048;
+
+/// The stages of a step, for timings and errors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// Positions and velocities handed to the step.
+    Input,
+    /// Normals, curvatures and bending forces.
+    Bending,
+    /// Internal axial forces.
+    InternalForces,
+    /// Unconstrained velocity.
+    Velocity,
+    /// Shape-constraint targets and iterations.
+    ShapeConstraints,
+    /// A collision pass (the hook).
+    Collision,
+    /// Position and hysteresis update.
+    Update,
+}
+
+/// A step that could not be completed; the state is as it was before the step.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// A parameter is outside its range.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    /// The state does not match the cloth.
+    #[error("the state has {found} {what}, the cloth {expected}")]
+    Mismatch {
+        /// What is counted.
+        what: &'static str,
+        /// The cloth's count.
+        expected: usize,
+        /// The state's count.
+        found: usize,
+    },
+    /// A value became NaN or infinite.
+    #[error("non-finite {quantity} at {location} {index} in stage {stage:?} (time {time} s)")]
+    NonFinite {
+        /// The stage that produced it.
+        stage: Stage,
+        /// What quantity.
+        quantity: &'static str,
+        /// "node" or "edge".
+        location: &'static str,
+        /// Its index.
+        index: usize,
+        /// Simulated time at the start of the step.
+        time: f64,
+    },
+}
+
+/// Per-stage wall time of one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageTimings {
+    /// Normals, curvature, bending force.
+    pub bending: Duration,
+    /// Internal forces.
+    pub internal: Duration,
+    /// Unconstrained velocity.
+    pub velocity: Duration,
+    /// Targets and constraint iterations.
+    pub shape: Duration,
+    /// Collision hook.
+    pub collision: Duration,
+    /// Update and diagnostics.
+    pub update: Duration,
+}
+
+impl StageTimings {
+    /// Sum of all stages.
+    pub fn total(&self) -> Duration {
+        self.bending + self.internal + self.velocity + self.shape + self.collision + self.update
+    }
+}
+
+/// Diagnostics of one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Internal-force iterations (axial phase, diagonal phase).
+    pub internal_iterations: [usize; 2],
+    /// Final E over its value at p = 0 (1 = nothing balanced, 0 = all external load carried).
+    pub internal_residual: f64,
+    /// Shape iterations over all passes.
+    pub shape_iterations: usize,
+    /// Conjugate-gradient iterations over all passes (Newton shape method only).
+    pub cg_iterations: usize,
+    /// RMS of the per-node length error R after the last iteration, m.
+    pub shape_residual: f64,
+    /// Largest |ε − ε̄| over the edges after the update (stretch-only edges: excess only).
+    pub max_strain_error: f64,
+    /// Kinetic energy after the step, J.
+    pub kinetic_energy: f64,
+    /// Fastest node after the step, m/s.
+    pub max_speed: f64,
+    /// Edges whose force per width lay above the measured range (strain extrapolated).
+    pub extrapolated_edges: usize,
+    /// The tolerance factor the policy applied (1 = tight).
+    pub tolerance_factor: f64,
+    /// Wall time per stage.
+    pub timings: StageTimings,
+}
+
+/// Everything a collision pass may look at and change.
+pub struct HookContext<'a> {
+    /// Positions at the start of the step.
+    pub positions: &'a [V3],
+    /// Velocities being corrected (the node moves by `velocity·dt` this step).
+    pub velocities: &'a mut [V3],
+    /// Inverse masses (0 for pinned nodes, which a hook must not move).
+    pub inverse_masses: &'a [f64],
+    /// Time step, s.
+    pub dt: f64,
+    /// Simulated time at the start of the step, s.
+    pub time: f64,
+    /// Which pass (0-based).
+    pub pass: usize,
+}
+
+/// A collision stage called between shape-constraint iterations.
+pub trait CollisionHook {
+    /// Resolve contacts by changing velocities.
+    fn resolve(&mut self, ctx: HookContext<'_>);
+}
+
+/// No collisions.
+pub struct NoCollision;
+
+impl CollisionHook for NoCollision {
+    fn resolve(&mut self, _ctx: HookContext<'_>) {}
+}
+
+/// Reusable scratch buffers of the step (no allocation once sized).
+#[derive(Default)]
+struct Scratch {
+    tri_normal: Vec<V3>,
+    normal: Vec<V3>,
+    dir: Vec<V3>,
+    len: Vec<f64>,
+    eta: Vec<[f64; SLOTS]>,
+    node_moment: Vec<f64>,
+    bend_stiffness: Vec<f64>,
+    f_sum: Vec<V3>,
+    f_m: Vec<V3>,
+    p: Vec<f64>,
+    p_prev: Vec<f64>,
+    p_y: Vec<f64>,
+    grad: Vec<f64>,
+    force_per_width: Vec<f64>,
+    target: Vec<f64>,
+    shear: Vec<f64>,
+    vel: Vec<V3>,
+    vel_prev: Vec<V3>,
+    vel_hat: Vec<V3>,
+    pred: Vec<V3>,
+    c: Vec<f64>,
+    cdir: Vec<V3>,
+    r: Vec<V3>,
+    wsum: Vec<f64>,
+    chunk: Vec<f64>,
+    cg_x: Vec<f64>,
+    cg_r: Vec<f64>,
+    cg_z: Vec<f64>,
+    cg_p: Vec<f64>,
+    cg_q: Vec<f64>,
+    cg_y: Vec<V3>,
+}
+
+/// The PARTY solver: stateless between steps apart from scratch buffers and cached step-size
+/// estimates; the simulation state is passed in explicitly.
+#[derive(Default)]
+pub struct Solver {
+    s: Scratch,
+    /// λ_max(AᵀA) of the axial and diagonal phases, estimated on the first step.
+    lambda: Option<[f64; 2]>,
+    /// External forces per node (N) added in the next steps; empty for none.
+    pub external_forces: Vec<V3>,
+}
+
+fn resize<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
+    if v.len() != n {
+        v.clear();
+        v.resize(n, x);
+    }
+}
+
+/// Deterministic sum of `f(i)` for `i < n`: fixed chunks summed in parallel, then in order.
+fn det_sum(chunk: &mut Vec<f64>, n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
+    let chunks = n.div_ceil(SUM_CHUNK);
+    resize(chunk, chunks, 0.0);
+    let body = |(k, out): (usize, &mut f64)| {
+        let end = ((k + 1) * SUM_CHUNK).min(n);
+        *out = (k * SUM_CHUNK..end).map(&f).sum();
+    };
+    if n >= PAR_MIN {
+        chunk.par_iter_mut().enumerate().for_each(body);
+    } else {
+        chunk.iter_mut().enumerate().for_each(body);
+    }
+    chunk.iter().sum()
+}
+
+/// `out[i] = f(i)` over a slice, in parallel above [`PAR_MIN`].
+fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync + Send) {
+    if out.len() >= PAR_MIN {
+        out.par_iter_mut().enumerate().for_each(|(i, o)| *o = f(i));
+    } else {
+        out.iter_mut().enumerate().for_each(|(i, o)| *o = f(i));
+    }
+}
+
+fn first_non_finite_v(v: &[V3]) -> Option<usize> {
+    v.iter()
+        .position(|x| !(x.x.is_finite() && x.y.is_finite() && x.z.is_finite()))
+}
+
+fn first_non_finite(v: &[f64]) -> Option<usize> {
+    v.iter().position(|x| !x.is_finite())
+}
+
+impl Solver {
+    /// A solver with empty scratch.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Forget cached estimates (call when switching to a different cloth or changing pins).
+    pub fn reset(&mut self) {
+        self.lambda = None;
+    }
+
+    /// One step without collisions.
+    pub fn step(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &StepParams,
+    ) -> Result<StepReport, StepError> {
+        self.step_with(cloth, state, params, &mut NoCollision)
+    }
+
+    /// One step with a collision hook between shape-constraint iterations.
+    pub fn step_with(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &StepParams,
+        hook: &mut dyn CollisionHook,
+    ) -> Result<StepReport, StepError> {
+        params.validate()?;
+        let topo = cloth.topology();
+        let (n, ne) = (topo.node_count(), topo.edges().len());
+        for (what, expected, found) in [
+            ("positions", n, state.positions.len()),
+            ("velocities", n, state.velocities.len()),
+            ("edge forces", ne, state.axial_force.len()),
+            ("tensile states", ne, state.tensile.len()),
+            ("bending states", n, state.bending.len()),
+            (
+                "cell shear angles",
+                topo.cells().len(),
+                state.shear_angle.len(),
+            ),
+        ] {
+            if expected != found {
+                return Err(StepError::Mismatch {
+                    what,
+                    expected,
+                    found,
+                });
+            }
+        }
+        let non_finite = |stage, quantity, location, index| StepError::NonFinite {
+            stage,
+            quantity,
+            location,
+            index,
+            time: state.time,
+        };
+        if let Some(i) = first_non_finite_v(&state.positions) {
+            return Err(non_finite(Stage::Input, "position", "node", i));
+        }
+        if let Some(i) = first_non_finite_v(&state.velocities) {
+            return Err(non_finite(Stage::Input, "velocity", "node", i));
+        }
+        self.size(n, ne, topo.triangles().len(), topo.cells().len());
+        let mut report = StepReport::default();
+        let dt = params.dt;
+
+        // 1. Geometry and bending.
+        let t0 = Instant::now();
+        self.geometry(cloth, state);
+        if params.bending_off {
+            self.s.f_sum.iter_mut().for_each(|f| *f = V3::zeros());
+            self.s.bend_stiffness.iter_mut().for_each(|k| *k = 0.0);
+        } else {
+            self.bending(cloth, state, params);
+        }
+        self.add_external(cloth, params);
+        if let Some(i) = first_non_finite_v(&self.s.f_sum) {
+            return Err(non_finite(Stage::Bending, "bending force", "node", i));
+        }
+        report.timings.bending = t0.elapsed();
+
+        // 2. Internal forces.
+        let t0 = Instant::now();
+        if self.lambda.is_none() {
+            self.lambda = Some([
+                self.estimate_lambda(cloth, false),
+                self.estimate_lambda(cloth, true),
+            ]);
+        }
+        let max_speed0 = state
+            .velocities
+            .iter()
+            .map(|v| v.norm())
+            .fold(0.0, f64::max);
+        report.tolerance_factor = params.tolerance_factor(max_speed0);
+        self.s.p.copy_from_slice(&state.axial_force);
+        let e0 = self.energy_at_zero(cloth);
+        report.internal_iterations[0] =
+            self.internal_phase(cloth, params, false, report.tolerance_factor);
+        report.internal_iterations[1] =
+            self.internal_phase(cloth, params, true, report.tolerance_factor);
+        self.gather(cloth, true);
+        let e = self.energy(cloth);
+        report.internal_residual = if e0 > 0.0 { e / e0 } else { 0.0 };
+        if let Some(i) = first_non_finite(&self.s.p) {
+            return Err(non_finite(Stage::InternalForces, "axial force", "edge", i));
+        }
+        report.timings.internal = t0.elapsed();
+
+        // 3. Unconstrained velocity.
+        let t0 = Instant::now();
+        self.unconstrained_velocity(cloth, state, params);
+        if let Some(i) = first_non_finite_v(&self.s.vel) {
+            return Err(non_finite(Stage::Velocity, "velocity", "node", i));
+        }
+        report.timings.velocity = t0.elapsed();
+
+        // 4. Shape constraints, interleaved with collision passes.
+        let t0 = Instant::now();
+        report.extrapolated_edges = self.targets(cloth, state, params);
+        if let Some(i) = first_non_finite(&self.s.target) {
+            return Err(non_finite(
+                Stage::ShapeConstraints,
+                "target length",
+                "edge",
+                i,
+            ));
+        }
+        let mut collision_time = Duration::ZERO;
+        for pass in 0..params.collision_passes {
+            let (iters, residual, cg) =
+                self.shape_iterations(cloth, state, params, report.tolerance_factor);
+            report.shape_iterations += iters;
+            report.cg_iterations += cg;
+            report.shape_residual = residual;
+            if let Some(i) = first_non_finite_v(&self.s.vel) {
+                return Err(non_finite(Stage::ShapeConstraints, "velocity", "node", i));
+            }
+            let tc = Instant::now();
+            hook.resolve(HookContext {
+                positions: &state.positions,
+                velocities: &mut self.s.vel,
+                inverse_masses: cloth.inverse_masses(),
+                dt,
+                time: state.time,
+                pass,
+            });
+            collision_time += tc.elapsed();
+            if let Some(i) = first_non_finite_v(&self.s.vel) {
+                return Err(non_finite(Stage::Collision, "velocity", "node", i));
+            }
+        }
+        report.timings.collision = collision_time;
+        report.timings.shape = t0.elapsed() - collision_time;
+
+        // 5. Update and commit.
+        let t0 = Instant::now();
+        let positions = &state.positions;
+        let vel = &self.s.vel;
+        fill(&mut self.s.pred, |i| positions[i] + vel[i] * dt);
+        if let Some(i) = first_non_finite_v(&self.s.pred) {
+            return Err(non_finite(Stage::Update, "position", "node", i));
+        }
+        std::mem::swap(&mut state.positions, &mut self.s.pred);
+        state.velocities.copy_from_slice(&self.s.vel);
+        state.axial_force.copy_from_slice(&self.s.p);
+        state.shear_angle.copy_from_slice(&self.s.shear);
+        self.commit_hysteresis(cloth, state, params);
+        state.time += dt;
+        report.max_strain_error = self.max_strain_error(cloth, state, params);
+        report.kinetic_energy = state.kinetic_energy(cloth);
+        report.max_speed = state
+            .velocities
+            .iter()
+            .map(|v| v.norm())
+            .fold(0.0, f64::max);
+        report.timings.update = t0.elapsed();
+        Ok(report)
+    }
+
+    fn size(&mut self, n: usize, ne: usize, nt: usize, nc: usize) {
+        let s = &mut self.s;
+        let z = V3::zeros();
+        resize(&mut s.tri_normal, nt, z);
+        for v in [
+            &mut s.normal,
+            &mut s.f_sum,
+            &mut s.f_m,
+            &mut s.vel,
+            &mut s.vel_prev,
+            &mut s.vel_hat,
+            &mut s.pred,
+            &mut s.r,
+        ] {
+            resize(v, n, z);
+        }
+        resize(&mut s.eta, n, [0.0; SLOTS]);
+        for v in [&mut s.node_moment, &mut s.bend_stiffness, &mut s.wsum] {
+            resize(v, n, 0.0);
+        }
+        resize(&mut s.dir, ne, z);
+        resize(&mut s.cdir, ne, z);
+        for v in [
+            &mut s.len,
+            &mut s.p,
+            &mut s.p_prev,
+            &mut s.p_y,
+            &mut s.grad,
+            &mut s.force_per_width,
+            &mut s.target,
+            &mut s.c,
+            &mut s.cg_x,
+            &mut s.cg_r,
+            &mut s.cg_z,
+            &mut s.cg_p,
+            &mut s.cg_q,
+        ] {
+            resize(v, ne, 0.0);
+        }
+        resize(&mut s.cg_y, n, z);
+        resize(&mut s.shear, nc, 0.0);
+        if self.external_forces.len() != n {
+            self.external_forces.clear();
+        }
+    }
+
+    /// Edge directions and lengths, triangle and node normals (area-weighted) at the start of
+    /// the step.
+    fn geometry(&mut self, cloth: &Cloth, state: &ClothState) {
+        let topo = cloth.topology();
+        let (edges, pos) = (topo.edges(), &state.positions);
+        let s = &mut self.s;
+        fill(&mut s.len, |e| {
+            (pos[edges[e].b as usize] - pos[edges[e].a as usize]).norm()
+        });
+        let len = &s.len;
+        fill(&mut s.dir, |e| {
+            let d = pos[edges[e].b as usize] - pos[edges[e].a as usize];
+            if len[e] > 0.0 {
+                d / len[e]
+            } else {
+                V3::zeros()
+            }
+        });
+        let tris = topo.triangles();
+        fill(&mut s.tri_normal, |t| {
+            let [a, b, c] = tris[t].map(|k| pos[k as usize]);
+            (b - a).cross(&(c - a))
+        });
+        let tn = &s.tri_normal;
+        fill(&mut s.normal, |i| {
+            let sum: V3 = topo
+                .incident_triangles(i)
+                .iter()
+                .map(|&t| tn[t as usize])
+                .sum();
+            let norm = sum.norm();
+            if norm > 0.0 { sum / norm } else { V3::zeros() }
+        });
+    }
+
+    /// Bending (28)–(32): curvature η = −2 n·(r_a − r_i)/l² per axial slot, moment per width
+    /// from the spindle (peeked through the hysteresis state), node moment
+    /// M = Σ_dir ½ Σ W_a m_a over directions with both neighbours (a free edge carries no moment),
+    /// force F = n Σ (M_a − M)/l_a. Also the diagonal bending stiffness for the implicit term.
+    fn bending(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
+        let topo = cloth.topology();
+        let (axial, areas, mats, table) = (
+            topo.axial_neighbours(),
+            topo.node_areas(),
+            cloth.slot_materials(),
+            cloth.materials(),
+        );
+        let pos = &state.positions;
+        let hysteresis = params.hysteresis && cloth.bending_hysteretic();
+        let s = &mut self.s;
+        let normal = &s.normal;
+        fill(&mut s.eta, |i| {
+            let mut eta = [0.0; SLOTS];
+            for k in 0..SLOTS {
+                let a = axial[i][k];
+                if a != NO_NODE {
+                    let d = pos[a as usize] - pos[i];
+                    eta[k] = -2.0 * normal[i].dot(&d) / d.norm_squared();
+                }
+            }
+            eta
+        });
+        let eta = &s.eta;
+        let bending_states = &state.bending;
+        fill(&mut s.node_moment, |i| {
+            let mut m = 0.0;
+            for dir in 0..2 {
+                let (k0, k1) = (2 * dir, 2 * dir + 1);
+                if axial[i][k0] == NO_NODE || axial[i][k1] == NO_NODE {
+                    continue;
+                }
+                for k in [k0, k1] {
+                    let spindle = table.bending(mats[i][k]);
+                    let l = (pos[axial[i][k] as usize] - pos[i]).norm();
+                    let per_width = if hysteresis {
+                        bending_states[i][k].moment(spindle, eta[i][k])
+                    } else {
+                        spindle.rigidity() * eta[i][k]
+                    };
+                    m += 0.5 * (areas[i] / l) * per_width;
+                }
+            }
+            m
+        });
+        let moment = &s.node_moment;
+        fill(&mut s.f_sum, |i| {
+            let f: f64 = axial[i]
+                .iter()
+                .filter(|&&a| a != NO_NODE)
+                .map(|&a| (moment[a as usize] - moment[i]) / (pos[a as usize] - pos[i]).norm())
+                .sum();
+            normal[i] * f
+        });
+        fill(&mut s.bend_stiffness, |i| {
+            (0..SLOTS)
+                .filter(|&k| axial[i][k] != NO_NODE)
+                .map(|k| {
+                    let l = (pos[axial[i][k] as usize] - pos[i]).norm();
+                    2.0 * areas[i] * table.bending(mats[i][k]).rigidity() / l.powi(4)
+                })
+                .sum()
+        });
+    }
+
+    /// F_sum += μ g + external forces.
+    fn add_external(&mut self, cloth: &Cloth, params: &StepParams) {
+        let g = params.gravity_vector();
+        let masses = cloth.masses();
+        let ext = &self.external_forces;
+        for (i, f) in self.s.f_sum.iter_mut().enumerate() {
+            *f += g * masses[i];
+            if let Some(x) = ext.get(i) {
+                *f += x;
+            }
+        }
+    }
+
+    /// F^m = F_sum + Σ p d over incident edges (diagonals only when `diagonals`), from p.
+    fn gather(&mut self, cloth: &Cloth, diagonals: bool) {
+        self.gather_from(cloth, diagonals, false);
+    }
+
+    /// The same from p (`from_y` false) or from the extrapolated point y of the accelerated
+    /// method (`from_y` true).
+    fn gather_from(&mut self, cloth: &Cloth, diagonals: bool, from_y: bool) {
+        let topo = cloth.topology();
+        let edges = topo.edges();
+        let s = &mut self.s;
+        let p: &[f64] = if from_y { &s.p_y } else { &s.p };
+        let (dir, f_sum) = (&s.dir, &s.f_sum);
+        fill(&mut s.f_m, |i| {
+            let mut f = f_sum[i];
+            for &e in topo.incident_edges(i) {
+                let edge = &edges[e as usize];
+                if !diagonals && !edge.kind.is_axial() {
+                    continue;
+                }
+                let sign = if edge.a as usize == i { 1.0 } else { -1.0 };
+                f += dir[e as usize] * (sign * p[e as usize]);
+            }
+            f
+        });
+    }
+
+    /// E = ½ Σ over free nodes |F^m|².
+    fn energy(&mut self, cloth: &Cloth) -> f64 {
+        let (f_m, inv) = (&self.s.f_m, cloth.inverse_masses());
+        0.5 * det_sum(&mut self.s.chunk, f_m.len(), |i| {
+            if inv[i] > 0.0 {
+                f_m[i].norm_squared()
+            } else {
+                0.0
+            }
+        })
+    }
+
+    fn energy_at_zero(&mut self, cloth: &Cloth) -> f64 {
+        let (f, inv) = (&self.s.f_sum, cloth.inverse_masses());
+        0.5 * det_sum(&mut self.s.chunk, f.len(), |i| {
+            if inv[i] > 0.0 {
+                f[i].norm_squared()
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// ∂E/∂p_e = (F^m_a [a free] − F^m_b [b free])·d_e for the edges of one phase.
+    fn gradient(&mut self, cloth: &Cloth, diagonals: bool) {
+        let topo = cloth.topology();
+        let edges = topo.edges();
+        let inv = cloth.inverse_masses();
+        let s = &mut self.s;
+        let (f_m, dir) = (&s.f_m, &s.dir);
+        fill(&mut s.grad, |e| {
+            let edge = &edges[e];
+            if edge.kind.is_axial() == diagonals {
+                return 0.0;
+            }
+            let (a, b) = (edge.a as usize, edge.b as usize);
+            let fa = if inv[a] > 0.0 { f_m[a] } else { V3::zeros() };
+            let fb = if inv[b] > 0.0 { f_m[b] } else { V3::zeros() };
+            (fa - fb).dot(&dir[e])
+        });
+    }
+
+    /// λ_max of AᵀA restricted to one phase's edges, by power iteration on the current geometry
+    /// (with a 10 % margin).
+    fn estimate_lambda(&mut self, cloth: &Cloth, diagonals: bool) -> f64 {
+        let edges = cloth.topology().edges();
+        let in_phase = |e: usize| edges[e].kind.is_axial() != diagonals;
+        if !(0..edges.len()).any(in_phase) {
+            return 1.0;
+        }
+        let saved_sum = std::mem::take(&mut self.s.f_sum);
+        self.s.f_sum = vec![V3::zeros(); saved_sum.len()];
+        let saved_p = self.s.p.clone();
+        for (e, p) in self.s.p.iter_mut().enumerate() {
+            *p = if in_phase(e) {
+                1.0 + 0.1 * ((e * 7919) % 13) as f64
+            } else {
+                0.0
+            };
+        }
+        let mut lambda = 1.0;
+        for _ in 0..40 {
+            self.gather(cloth, diagonals);
+            self.gradient(cloth, diagonals);
+            let norm_p = self.s.p.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let norm_g = self.s.grad.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm_g == 0.0 {
+                break;
+            }
+            lambda = norm_g / norm_p;
+            let (grad, p) = (&self.s.grad, &mut self.s.p);
+            for (pi, gi) in p.iter_mut().zip(grad) {
+                *pi = gi / norm_g;
+            }
+        }
+        self.s.f_sum = saved_sum;
+        self.s.p = saved_p;
+        1.1 * lambda.max(1e-12)
+    }
+
+    /// One phase of the internal-force solve (thesis (45)–(47)): projected steepest descent, or
+    /// the accelerated variant; only this phase's p change. Returns the iterations used.
+    fn internal_phase(
+        &mut self,
+        cloth: &Cloth,
+        params: &StepParams,
+        diagonals: bool,
+        factor: f64,
+    ) -> usize {
+        let edges = cloth.topology().edges();
+        let lambda = self.lambda.map_or(1.0, |l| l[usize::from(diagonals)]);
+        let mut gamma = params.internal_step / lambda;
+        let tol = params.internal_tolerance * factor;
+        let in_phase = |e: usize| edges[e].kind.is_axial() != diagonals;
+        self.gather(cloth, diagonals);
+        let mut e_old = self.energy(cloth);
+        if e_old == 0.0 {
+            return 0;
+        }
+        let mut iterations = 0;
+        match params.internal_method {
+            InternalMethod::SteepestDescent => {
+                while iterations < params.internal_max_iterations {
+                    iterations += 1;
+                    self.gradient(cloth, diagonals);
+                    self.s.p_prev.copy_from_slice(&self.s.p);
+                    let (grad, p) = (&self.s.grad, &mut self.s.p);
+                    for (e, pe) in p.iter_mut().enumerate() {
+                        if in_phase(e) {
+                            *pe = (*pe - gamma * grad[e]).max(0.0);
+                        }
+                    }
+                    self.gather(cloth, diagonals);
+                    let e_new = self.energy(cloth);
+                    if e_new > e_old * (1.0 + 1e-12) {
+                        // Step too long for this geometry: back off and re-estimate next step.
+                        self.s.p.copy_from_slice(&self.s.p_prev);
+                        self.gather(cloth, diagonals);
+                        gamma *= 0.5;
+                        self.lambda = None;
+                        continue;
+                    }
+                    let change = (e_old - e_new) / e_old;
+                    e_old = e_new;
+                    if change < tol || e_new == 0.0 {
+                        break;
+                    }
+                }
+            }
+            InternalMethod::Accelerated => {
+                // FISTA with gradient restart (O'Donoghue & Candès 2015).
+                self.s.p_prev.copy_from_slice(&self.s.p);
+                let mut t: f64 = 1.0;
+                let mut e_y_old = e_old;
+                while iterations < params.internal_max_iterations {
+                    iterations += 1;
+                    let t_next = 0.5 * (1.0 + (1.0 + 4.0 * t * t).sqrt());
+                    let beta = (t - 1.0) / t_next;
+                    {
+                        let (p, prev, y) = (&self.s.p, &self.s.p_prev, &mut self.s.p_y);
+                        for e in 0..y.len() {
+                            y[e] = if in_phase(e) {
+                                p[e] + beta * (p[e] - prev[e])
+                            } else {
+                                p[e]
+                            };
+                        }
+                    }
+                    self.gather_from(cloth, diagonals, true);
+                    let e_y = self.energy(cloth);
+                    self.gradient(cloth, diagonals);
+                    let mut restart = 0.0;
+                    {
+                        let (p, prev, y, grad) =
+                            (&mut self.s.p, &mut self.s.p_prev, &self.s.p_y, &self.s.grad);
+                        for e in 0..p.len() {
+                            if in_phase(e) {
+                                let new = (y[e] - gamma * grad[e]).max(0.0);
+                                restart += (y[e] - new) * (new - p[e]);
+                                prev[e] = p[e];
+                                p[e] = new;
+                            }
+                        }
+                    }
+                    t = if restart > 0.0 { 1.0 } else { t_next };
+                    let change = (e_y_old - e_y).abs() / e_y_old.max(f64::MIN_POSITIVE);
+                    e_y_old = e_y;
+                    if (change < tol && iterations > 2) || e_y == 0.0 {
+                        break;
+                    }
+                }
+                self.gather(cloth, diagonals);
+                if self.energy(cloth) > e_old * (1.0 + 1e-9) {
+                    // Diverged on this geometry: fall back to the warm start and re-estimate.
+                    self.lambda = None;
+                }
+            }
+        }
+        iterations
+    }
+
+    /// (18): ṙ⁰ = (μṙ + F^m Δt)/(μ + cΔt), with the bending stiffness k added implicitly along
+    /// the normal, (μ + cΔt + kΔt²). Pinned nodes take their prescribed velocity.
+    fn unconstrained_velocity(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
+        let dt = params.dt;
+        let (mass, areas) = (cloth.masses(), cloth.topology().node_areas());
+        let implicit = params.implicit_bending && !params.bending_off;
+        let s = &mut self.s;
+        let (f_m, normal, k_bend) = (&s.f_m, &s.normal, &s.bend_stiffness);
+        let (vel0, pos) = (&state.velocities, &state.positions);
+        fill(&mut s.vel, |i| {
+            if cloth.is_pinned(i) {
+                return V3::zeros();
+            }
+            let mu = mass[i];
+            let c = params.damping * areas[i];
+            let v = (vel0[i] * mu + f_m[i] * dt) / (mu + c * dt);
+            if implicit && k_bend[i] > 0.0 {
+                let n = normal[i];
+                let vn = (mu * vel0[i].dot(&n) + f_m[i].dot(&n) * dt)
+                    / (mu + c * dt + k_bend[i] * dt * dt);
+                v - n * v.dot(&n) + n * vn
+            } else {
+                v
+            }
+        });
+        let t1 = state.time + dt;
+        for pin in cloth.pins() {
+            let i = pin.node as usize;
+            s.vel[i] = (pin.position(t1) - pos[i]) / dt;
+        }
+    }
+
+    /// Target lengths: axial edges l⁰(1 + φ_θ(p/W)) through their hysteresis state (25); each
+    /// cell's diagonals from the cell's axial targets and its shear angle γ(τ),
+    /// τ = p₊/D₊ − p₋/D₋ (parallelogram geometry). Returns the number of extrapolated edges.
+    fn targets(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) -> usize {
+        let topo = cloth.topology();
+        let edges = topo.edges();
+        let (widths, mats, table) = (
+            cloth.edge_widths(),
+            cloth.edge_materials(),
+            cloth.materials(),
+        );
+        let hysteresis = params.hysteresis && cloth.tensile_hysteretic();
+        let s = &mut self.s;
+        let p = &s.p;
+        fill(&mut s.force_per_width, |e| {
+            if edges[e].kind.is_axial() {
+                p[e] / widths[e]
+            } else {
+                0.0
+            }
+        });
+        let fpw = &s.force_per_width;
+        let tensile = &state.tensile;
+        fill(&mut s.target, |e| {
+            let edge = &edges[e];
+            if !edge.kind.is_axial() {
+                return edge.rest_length;
+            }
+            let l = table.tensile(mats[e]);
+            let strain = if hysteresis {
+                tensile[e].strain(l, fpw[e])
+            } else {
+                l.strain(Branch::Loading, fpw[e])
+            };
+            edge.rest_length * (1.0 + strain)
+        });
+        let extrapolated = (0..edges.len())
+            .filter(|&e| edges[e].kind.is_axial() && !table.tensile(mats[e]).in_range(fpw[e]))
+            .count();
+        let shear_curve = cloth.shear_curve();
+        let cells = topo.cells();
+        fill(&mut s.shear, |c| {
+            let cell = &cells[c];
+            let [dp, dm] = cell
+                .diagonals
+                .map(|d| p[d as usize] / edges[d as usize].rest_length);
+            shear_curve.angle(dp - dm)
+        });
+        for (c, cell) in cells.iter().enumerate() {
+            let mean =
+                |pair: [u32; 2], t: &[f64]| 0.5 * (t[pair[0] as usize] + t[pair[1] as usize]);
+            let (a, b) = (mean(cell.u_edges, &s.target), mean(cell.v_edges, &s.target));
+            let rest = |pair: [u32; 2]| {
+                0.5 * (edges[pair[0] as usize].rest_length + edges[pair[1] as usize].rest_length)
+            };
+            let (a0, b0) = (rest(cell.u_edges), rest(cell.v_edges));
+            let (alpha0, alpha) = (cell.rest_angle, cell.rest_angle - s.shear[c]);
+            for (k, sign) in [(0, 1.0), (1, -1.0)] {
+                let d = cell.diagonals[k] as usize;
+                let now = a * a + b * b + sign * 2.0 * a * b * alpha.cos();
+                let rest = a0 * a0 + b0 * b0 + sign * 2.0 * a0 * b0 * alpha0.cos();
+                s.target[d] = edges[d].rest_length * (now.max(0.0) / rest).sqrt();
+            }
+        }
+        extrapolated
+    }
+
+    /// Shape-constraint iterations (49)–(51): predicted positions r + ṙΔt; per edge the error
+    /// C = l − l_target (stretch-only edges: only C > 0); per node R = Σ w_i/(w_i + w_a) C d
+    /// and the scaled velocity step ṙ += γ R/(D Δt), D the node's constraint weight; plain
+    /// (Jacobi) or Chebyshev-accelerated. Stops when RMS(R) < ε^e or at the cap.
+    fn shape_iterations(
+        &mut self,
+        cloth: &Cloth,
+        state: &ClothState,
+        params: &StepParams,
+        factor: f64,
+    ) -> (usize, f64, usize) {
+        let topo = cloth.topology();
+        let edges = topo.edges();
+        let inv = cloth.inverse_masses();
+        let dt = params.dt;
+        let tol = params.shape_tolerance * factor;
+        let free = inv.iter().filter(|&&w| w > 0.0).count().max(1) as f64;
+        let mut omega = 1.0;
+        let mut residual = 0.0;
+        let mut iterations = 0;
+        let mut cg_total = 0;
+        self.s.vel_prev.copy_from_slice(&self.s.vel);
+        for k in 0..params.shape_max_iterations {
+            let s = &mut self.s;
+            let (pos, vel) = (&state.positions, &s.vel);
+            fill(&mut s.pred, |i| pos[i] + vel[i] * dt);
+            let (pred, target) = (&s.pred, &s.target);
+            fill(&mut s.cdir, |e| {
+                let d = pred[edges[e].b as usize] - pred[edges[e].a as usize];
+                let l = d.norm();
+                if l > 0.0 { d / l } else { V3::zeros() }
+            });
+            fill(&mut s.c, |e| {
+                let edge = &edges[e];
+                let l = (pred[edge.b as usize] - pred[edge.a as usize]).norm();
+                let c = l - target[e];
+                let kind = if edge.kind.is_axial() {
+                    params.axial_constraint
+                } else {
+                    params.diagonal_constraint
+                };
+                match kind {
+                    ConstraintKind::Equality => c,
+                    ConstraintKind::StretchOnly => c.max(0.0),
+                }
+            });
+            let (c, cdir) = (&s.c, &s.cdir);
+            fill(&mut s.r, |i| {
+                if inv[i] == 0.0 {
+                    return V3::zeros();
+                }
+                let mut r = V3::zeros();
+                for &e in topo.incident_edges(i) {
+                    let edge = &edges[e as usize];
+                    let (other, sign) = if edge.a as usize == i {
+                        (edge.b, 1.0)
+                    } else {
+                        (edge.a, -1.0)
+                    };
+                    let w = inv[i] / (inv[i] + inv[other as usize]);
+                    r += cdir[e as usize] * (sign * w * c[e as usize]);
+                }
+                r
+            });
+            fill(&mut s.wsum, |i| {
+                if inv[i] == 0.0 {
+                    return 0.0;
+                }
+                topo.incident_edges(i)
+                    .iter()
+                    .map(|&e| {
+                        let edge = &edges[e as usize];
+                        let other = if edge.a as usize == i { edge.b } else { edge.a };
+                        inv[i] / (inv[i] + inv[other as usize])
+                    })
+                    .sum()
+            });
+            let r = &s.r;
+            residual = (det_sum(&mut s.chunk, r.len(), |i| r[i].norm_squared()) / free).sqrt();
+            if residual < tol {
+                break;
+            }
+            iterations += 1;
+            // Half the total weight: a node pulled by d equal constraints moves by their mean.
+            if matches!(
+                params.shape_method,
+                ShapeMethod::Jacobi | ShapeMethod::Chebyshev { .. }
+            ) {
+                let (vel, wsum, gamma) = (&s.vel, &s.wsum, params.shape_step);
+                fill(&mut s.vel_hat, |i| {
+                    if wsum[i] > 0.0 {
+                        vel[i] + r[i] * (2.0 * gamma / (wsum[i] * dt))
+                    } else {
+                        vel[i]
+                    }
+                });
+            }
+            match params.shape_method {
+                ShapeMethod::Newton {
+                    cg_iterations,
+                    cg_tolerance,
+                } => {
+                    cg_total += Self::newton_projection(s, cloth, dt, cg_iterations, cg_tolerance);
+                }
+                ShapeMethod::GaussSeidel { omega } => {
+                    for colour in 0..cloth.colour_count() {
+                        let (vel, pos, target) = (&s.vel, &state.positions, &s.target);
+                        fill(&mut s.vel_hat, |i| {
+                            let e = cloth.colour_edge(i, colour);
+                            if e == NO_NODE || inv[i] == 0.0 {
+                                return vel[i];
+                            }
+                            let edge = &edges[e as usize];
+                            let (a, b) = (edge.a as usize, edge.b as usize);
+                            let d = (pos[b] + vel[b] * dt) - (pos[a] + vel[a] * dt);
+                            let l = d.norm();
+                            let kind = if edge.kind.is_axial() {
+                                params.axial_constraint
+                            } else {
+                                params.diagonal_constraint
+                            };
+                            let mut c = l - target[e as usize];
+                            if kind == ConstraintKind::StretchOnly {
+                                c = c.max(0.0);
+                            }
+                            if l == 0.0 || c == 0.0 {
+                                return vel[i];
+                            }
+                            let (wa, wb) = (inv[a], inv[b]);
+                            let delta = omega * c / (wa + wb);
+                            let sign = if i == a { wa } else { -wb };
+                            vel[i] + d * (sign * delta / (l * dt))
+                        });
+                        std::mem::swap(&mut s.vel, &mut s.vel_hat);
+                    }
+                }
+                ShapeMethod::Jacobi => std::mem::swap(&mut s.vel, &mut s.vel_hat),
+                ShapeMethod::Chebyshev { rho } => {
+                    omega = match k {
+                        0 => 1.0,
+                        1 => 2.0 / (2.0 - rho * rho),
+                        _ => 4.0 / (4.0 - rho * rho * omega),
+                    };
+                    let (hat, prev) = (&s.vel_hat, &s.vel_prev);
+                    let new: &mut Vec<V3> = &mut s.pred;
+                    fill(new, |i| prev[i] + (hat[i] - prev[i]) * omega);
+                    std::mem::swap(&mut s.vel_prev, &mut s.vel);
+                    std::mem::swap(&mut s.vel, &mut s.pred);
+                }
+            }
+            for pin in cloth.pins() {
+                let i = pin.node as usize;
+                let v = (pin.position(state.time + dt) - state.positions[i]) / dt;
+                s.vel[i] = v;
+                s.vel_prev[i] = v;
+            }
+        }
+        (iterations, residual, cg_total)
+    }
+
+    /// One Gauss–Newton step on the shape objective E^e = ½ Σ (l − l_target)² (49): the
+    /// correction δx minimising |C + J δx|² (J at the predicted positions) with the least change
+    /// in the mass metric, found by Jacobi-preconditioned CG on
+    /// `(W^½ JᵀJ W^½ + εI) y = −W^½ Jᵀ C`, `δx = W^½ y` (pinned nodes have W = 0 and do not
+    /// move); then ṙ += δx/Δt. Unlike the dual (λ) form this stays well posed when the
+    /// 8-neighbourhood's targets are not exactly compatible. Uses `s.c` and `s.cdir` as computed
+    /// for the residual; returns the CG iterations.
+    fn newton_projection(
+        s: &mut Scratch,
+        cloth: &Cloth,
+        dt: f64,
+        max_cg: usize,
+        cg_tol: f64,
+    ) -> usize {
+        let topo = cloth.topology();
+        let edges = topo.edges();
+        let inv = cloth.inverse_masses();
+        let n = inv.len();
+        let sqrt_w = |i: usize| inv[i].sqrt();
+        // Levenberg regularisation, tiny against the operator's diagonal (~ w·degree).
+        let mean_diag = inv.iter().map(|w| w * 8.0).sum::<f64>() / n as f64;
+        let eps = 1e-10 * mean_diag;
+        // out = (W^½ Jᵀ J W^½ + ε) y, with q_e = J_e W^½ y.
+        fn apply(
+            topo: &atelier_grid::ClothTopology,
+            inv: &[f64],
+            cdir: &[V3],
+            eps: f64,
+            y: &[V3],
+            q: &mut [f64],
+            out: &mut [V3],
+        ) {
+            let edges = topo.edges();
+            fill(q, |e| {
+                let (a, b) = (edges[e].a as usize, edges[e].b as usize);
+                cdir[e].dot(&(y[b] * inv[b].sqrt() - y[a] * inv[a].sqrt()))
+            });
+            let q: &[f64] = q;
+            fill(out, |i| {
+                let mut acc = V3::zeros();
+                for &e in topo.incident_edges(i) {
+                    let sign = if edges[e as usize].a as usize == i {
+                        -1.0
+                    } else {
+                        1.0
+                    };
+                    acc += cdir[e as usize] * (sign * q[e as usize]);
+                }
+                acc * inv[i].sqrt() + y[i] * eps
+            });
+        }
+        let (c, cdir) = (&s.c, &s.cdir);
+        // rhs = −W^½ Jᵀ C, kept in r; x (here `pred` reused as y) starts at 0.
+        fill(&mut s.r, |i| {
+            let mut acc = V3::zeros();
+            for &e in topo.incident_edges(i) {
+                let sign = if edges[e as usize].a as usize == i {
+                    -1.0
+                } else {
+                    1.0
+                };
+                acc += cdir[e as usize] * (sign * c[e as usize]);
+            }
+            -acc * sqrt_w(i)
+        });
+        let diag = |i: usize| inv[i] * topo.incident_edges(i).len() as f64 * 0.5 + eps;
+        s.pred.iter_mut().for_each(|y| *y = V3::zeros());
+        {
+            let (r, z) = (&s.r, &mut s.vel_hat);
+            fill(z, |i| r[i] / diag(i));
+        }
+        s.vel_prev.copy_from_slice(&s.vel_hat); // search direction p
+        let (r, z) = (&s.r, &s.vel_hat);
+        let mut rz = det_sum(&mut s.chunk, n, |i| r[i].dot(&z[i]));
+        let r0 = det_sum(&mut s.chunk, n, |i| r[i].norm_squared()).sqrt();
+        let mut iterations = 0;
+        if r0 > 0.0 {
+            while iterations < max_cg {
+                iterations += 1;
+                apply(
+                    topo,
+                    inv,
+                    &s.cdir,
+                    eps,
+                    &s.vel_prev,
+                    &mut s.cg_q,
+                    &mut s.cg_y,
+                );
+                let (p, ap) = (&s.vel_prev, &s.cg_y);
+                let pap = det_sum(&mut s.chunk, n, |i| p[i].dot(&ap[i]));
+                if pap.is_nan() || pap <= 0.0 {
+                    break;
+                }
+                let alpha = rz / pap;
+                for i in 0..n {
+                    s.pred[i] += s.vel_prev[i] * alpha;
+                    s.r[i] -= s.cg_y[i] * alpha;
+                }
+                let r = &s.r;
+                let rn = det_sum(&mut s.chunk, n, |i| r[i].norm_squared()).sqrt();
+                if rn <= cg_tol * r0 {
+                    break;
+                }
+                {
+                    let (r, z) = (&s.r, &mut s.vel_hat);
+                    fill(z, |i| r[i] / diag(i));
+                }
+                let (r, z) = (&s.r, &s.vel_hat);
+                let rz_new = det_sum(&mut s.chunk, n, |i| r[i].dot(&z[i]));
+                let beta = rz_new / rz;
+                rz = rz_new;
+                for i in 0..n {
+                    s.vel_prev[i] = s.vel_hat[i] + s.vel_prev[i] * beta;
+                }
+            }
+        }
+        for i in 0..n {
+            s.vel[i] += s.pred[i] * (sqrt_w(i) / dt);
+        }
+        iterations
+    }
+
+    /// Commit the hysteresis states at this step's forces and curvatures.
+    fn commit_hysteresis(&mut self, cloth: &Cloth, state: &mut ClothState, params: &StepParams) {
+        if !params.hysteresis {
+            return;
+        }
+        let topo = cloth.topology();
+        let (edges, mats, table) = (topo.edges(), cloth.edge_materials(), cloth.materials());
+        if cloth.tensile_hysteretic() {
+            let fpw = &self.s.force_per_width;
+            for (e, st) in state.tensile.iter_mut().enumerate() {
+                if edges[e].kind.is_axial() {
+                    st.update(table.tensile(mats[e]), fpw[e]);
+                }
+            }
+        }
+        if cloth.bending_hysteretic() && !params.bending_off {
+            let (axial, smats, eta) =
+                (topo.axial_neighbours(), cloth.slot_materials(), &self.s.eta);
+            for (i, slots) in state.bending.iter_mut().enumerate() {
+                for (k, st) in slots.iter_mut().enumerate() {
+                    if axial[i][k] != NO_NODE {
+                        st.update(table.bending(smats[i][k]), eta[i][k]);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Largest |ε − ε̄| after the update (stretch-only edges count only excess stretch).
+    fn max_strain_error(&self, cloth: &Cloth, state: &ClothState, params: &StepParams) -> f64 {
+        let edges = cloth.topology().edges();
+        let pos = &state.positions;
+        edges
+            .iter()
+            .enumerate()
+            .map(|(e, edge)| {
+                let l = (pos[edge.b as usize] - pos[edge.a as usize]).norm();
+                let err = (l - self.s.target[e]) / edge.rest_length;
+                let kind = if edge.kind.is_axial() {
+                    params.axial_constraint
+                } else {
+                    params.diagonal_constraint
+                };
+                match kind {
+                    ConstraintKind::Equality => err.abs(),
+                    ConstraintKind::StretchOnly => err.max(0.0),
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+}
