@@ -27,6 +27,9 @@ use crate::units;
 pub struct Spindle {
     rigidity: f64,
     residual_moment: f64,
+    /// Largest tangent of the initial and reversal curves as a multiple of B (∞: the exact
+    /// square roots, infinitely steep at every turning point).
+    stick_slope: f64,
 }
 
 impl Spindle {
@@ -55,6 +58,7 @@ impl Spindle {
         Ok(Self {
             rigidity,
             residual_moment,
+            stick_slope: f64::INFINITY,
         })
     }
 
@@ -64,6 +68,31 @@ impl Spindle {
             units::rigidity_from_kes(b),
             units::moment_from_kes(two_hb) / 2.0,
         )
+    }
+
+    /// The same characteristic with the square-root curves regularised: within a tiny band
+    /// after each turning point the curve is the straight chord of slope `slope·B`, joining the
+    /// square root where it reaches it (at `|η − η_t| = 4M₀/(slope²B)` on the initial curve,
+    /// `8M₀/(slope²B)` on a reversal curve). The exact curves are infinitely steep at a turning
+    /// point, which makes an explicit bending force amplify rounding noise ("chatter"); with a
+    /// finite slope the loop keeps its branches, widths and joins. `slope` must exceed 1;
+    /// `f64::INFINITY` restores the exact curves.
+    pub fn with_stick_slope(mut self, slope: f64) -> Self {
+        self.stick_slope = if slope > 1.0 { slope } else { f64::INFINITY };
+        self
+    }
+
+    /// The regularisation slope (multiple of B), ∞ when exact.
+    pub fn stick_slope(&self) -> f64 {
+        self.stick_slope
+    }
+
+    /// `√(k·Δ·M₀·B)` (k = 4 on the initial curve, 8 on reversal curves), replaced by its chord
+    /// of slope `stick_slope·B` where that lies below it.
+    #[inline]
+    fn root(&self, k: f64, delta: f64) -> f64 {
+        let exact = (k * delta * self.residual_moment * self.rigidity).sqrt();
+        exact.min(self.stick_slope * self.rigidity * delta)
     }
 
     /// Bending rigidity B, N·m.
@@ -95,7 +124,7 @@ impl Spindle {
     pub fn initial_curve(&self, curvature: f64) -> f64 {
         let x = curvature.abs();
         let m = if x * self.rigidity < self.residual_moment {
-            (4.0 * x * self.residual_moment * self.rigidity).sqrt()
+            self.root(4.0, x)
         } else {
             self.rigidity * x + self.residual_moment
         };
@@ -109,6 +138,14 @@ impl Spindle {
             return 0.0;
         }
         let eight_mb = 8.0 * self.residual_moment * self.rigidity;
+        // Within the regularised chord (slope s·B against the branch's B) the crossing is linear.
+        if self.stick_slope.is_finite() {
+            let chord_end = 8.0 * self.residual_moment / (self.stick_slope * self.stick_slope * self.rigidity);
+            let linear = a / ((self.stick_slope - 1.0) * self.rigidity);
+            if linear <= chord_end {
+                return linear;
+            }
+        }
         let disc = (eight_mb - 4.0 * self.rigidity * a).max(0.0);
         let x = 2.0 * a / (eight_mb.sqrt() + disc.sqrt());
         x * x
@@ -189,7 +226,7 @@ impl BendingState {
             Mode::Rising => {
                 let d = (eta - self.turn_curvature).max(0.0);
                 if d < self.reach {
-                    self.turn_moment + (8.0 * d * s.residual_moment * s.rigidity).sqrt()
+                    self.turn_moment + s.root(8.0, d)
                 } else {
                     s.rising_branch(eta)
                 }
@@ -197,7 +234,7 @@ impl BendingState {
             Mode::Falling => {
                 let d = (self.turn_curvature - eta).max(0.0);
                 if d < self.reach {
-                    self.turn_moment - (8.0 * d * s.residual_moment * s.rigidity).sqrt()
+                    self.turn_moment - s.root(8.0, d)
                 } else {
                     s.falling_branch(eta)
                 }
@@ -440,5 +477,27 @@ mod tests {
             Spindle::new(1.0, f64::NAN).expect_err("nan").kind,
             ErrorKind::NotFinite
         );
+    }
+
+    #[test]
+    fn regularised_curves_keep_the_loop_and_bound_the_slope() {
+        let s = cotton().with_stick_slope(4.0);
+        let b = s.rigidity();
+        // Slope near a turning point is at most 4B.
+        let mut st = BendingState::VIRGIN;
+        st.update(&s, 150.0);
+        st.update(&s, 149.0);
+        let (m1, m2) = (st.branch_moment(&s, 150.0 - 1e-6), st.branch_moment(&s, 150.0 - 2e-6));
+        assert!(((m1 - m2) / 1e-6).abs() <= 4.0 * b * (1.0 + 1e-9));
+        // Far from turning points the loop is unchanged: the KES cycle gives B and 2HB.
+        let t = kes_bending_test(&s, 200);
+        assert!((t.rigidity / b - 1.0).abs() < 0.01);
+        assert!((t.hysteresis / (2.0 * s.residual_moment()) - 1.0).abs() < 0.01);
+        // The reversal from the branch still joins the opposite branch.
+        let mut st = BendingState::VIRGIN;
+        st.update(&s, 200.0);
+        let span = 2.0 * s.residual_moment() / b;
+        assert_relative_eq!(st.moment(&s, 200.0 - span), s.falling_branch(200.0 - span), max_relative = 1e-9);
+        assert_eq!(cotton().with_stick_slope(0.5).stick_slope(), f64::INFINITY);
     }
 }

@@ -419,6 +419,15 @@ impl MaterialTable {
         Ok((table, indices))
     }
 
+    /// The same table with every tensile loop transformed by `f` (for example a linear toe).
+    #[must_use]
+    pub fn map_tensile(mut self, f: impl Fn(&TensileLoop) -> TensileLoop) -> Self {
+        for l in &mut self.tensile {
+            *l = f(l);
+        }
+        self
+    }
+
     /// The interpolation law used.
     pub fn form(&self) -> AnisotropyForm {
         self.form

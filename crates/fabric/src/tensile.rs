@@ -274,6 +274,32 @@ impl TensileLoop {
         Self::from_fn(f_max, |f| (up.eval(f).max(0.0), down.eval(f).max(0.0)))
     }
 
+    /// The same loop with a linear toe: below the force `f0` (N/m) each branch is replaced by
+    /// its chord from its zero-force strain to its strain at `f0`. A loop synthesised from KES
+    /// summary values (`f = Fm (ε/EMT)^k`, k > 1) has zero initial stiffness, so its strain is
+    /// infinitely sensitive to force near zero; in the constraint solver that sensitivity turns
+    /// tiny spurious forces into strains and feeds back (see `docs/solver.md`). Real fabrics have
+    /// a finite initial modulus; the chord gives them one. Unchanged above `f0`; apex, residual
+    /// strain and minor-loop pivots are kept. `f0` is clamped to `[0, f_max]`.
+    pub fn with_linear_toe(&self, f0: f64) -> Self {
+        let f0 = f0.clamp(0.0, self.f_max);
+        if f0 <= 0.0 {
+            return self.clone();
+        }
+        let (load_f0, unload_f0) = (self.strain(Branch::Loading, f0), self.strain(Branch::Unloading, f0));
+        let (load0, unload0) = (self.load[0], self.unload[0]);
+        let mut out = self.clone();
+        for j in 0..=TABLE_SEGMENTS {
+            let f = knot_force(self.f_max, j);
+            if f >= f0 {
+                break;
+            }
+            out.load[j] = load0 + (load_f0 - load0) * f / f0;
+            out.unload[j] = unload0 + (unload_f0 - unload0) * f / f0;
+        }
+        out
+    }
+
     /// The apex force (largest tabulated force), N/m.
     pub fn max_force(&self) -> f64 {
         self.f_max
@@ -737,5 +763,26 @@ mod tests {
             }
         }
         assert!(worst > 0.01, "largest excursion {worst} of EMT");
+    }
+
+    #[test]
+    fn linear_toe_is_a_chord_and_keeps_the_rest() {
+        let l = TensileLoop::from_summary(&cotton()).expect("loop");
+        let f0 = 0.01 * l.max_force();
+        let t = l.with_linear_toe(f0);
+        for &f in &[0.1 * f0, 0.5 * f0, 0.9 * f0] {
+            let chord = l.strain(Branch::Loading, f0) * f / f0;
+            assert!((t.strain(Branch::Loading, f) - chord).abs() < 1e-6 * l.apex_strain());
+            assert!(t.strain(Branch::Loading, f) < l.strain(Branch::Loading, f));
+            assert!(t.strain(Branch::Unloading, f) >= t.strain(Branch::Loading, f));
+        }
+        for &f in &[f0, 2.0 * f0, 0.5 * l.max_force(), l.max_force()] {
+            assert_relative_eq!(t.strain(Branch::Loading, f), l.strain(Branch::Loading, f), max_relative = 1e-9);
+            assert_relative_eq!(t.strain(Branch::Unloading, f), l.strain(Branch::Unloading, f), max_relative = 1e-9);
+        }
+        assert_relative_eq!(t.residual_strain(), l.residual_strain());
+        // Finite initial compliance: the strain at a tiny force is proportional to it.
+        let tiny = 1e-6 * f0;
+        assert!(t.strain(Branch::Loading, tiny) < 1e-5 * l.apex_strain());
     }
 }

@@ -102,17 +102,43 @@ pub struct Cloth {
     pin_of: Vec<u32>,
 }
 
+/// How a fabric is turned into a cloth's materials.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClothOptions {
+    /// Orthotropic interpolation law. Default `Thesis`.
+    pub form: AnisotropyForm,
+    /// Linear toe of every tensile loop below this fraction of its maximum force
+    /// (`TensileLoop::with_linear_toe`): a finite initial modulus instead of the synthetic
+    /// curves' zero one, which otherwise makes the strain targets infinitely sensitive to tiny
+    /// forces and the step unstable (measured in `docs/solver.md`). Range [0, 1); default 0.01
+    /// (5 gf/cm at the KES Fm).
+    pub toe_fraction: f64,
+}
+
+impl Default for ClothOptions {
+    fn default() -> Self {
+        Self {
+            form: AnisotropyForm::Thesis,
+            toe_fraction: 0.01,
+        }
+    }
+}
+
 impl Cloth {
-    /// Build a cloth from a topology and a fabric, interpolating the fabric to every distinct
-    /// edge angle once.
-    pub fn new(
-        topology: ClothTopology,
-        fabric: &Fabric,
-        form: AnisotropyForm,
-    ) -> Result<Self, ClothError> {
+    /// Build a cloth from a topology and a fabric with the default [`ClothOptions`] and the
+    /// given anisotropy form.
+    pub fn new(topology: ClothTopology, fabric: &Fabric, form: AnisotropyForm) -> Result<Self, ClothError> {
+        Self::with_options(topology, fabric, ClothOptions { form, ..ClothOptions::default() })
+    }
+
+    /// Build a cloth, interpolating the fabric to every distinct edge angle once.
+    pub fn with_options(topology: ClothTopology, fabric: &Fabric, options: ClothOptions) -> Result<Self, ClothError> {
+        let form = options.form;
         let angles: Vec<f64> = topology.edges().iter().map(|e| e.material_angle).collect();
-        let (materials, edge_material) =
-            MaterialTable::build(fabric, form, &angles).map_err(|source| ClothError::Material {
+        let toe = if (0.0..1.0).contains(&options.toe_fraction) { options.toe_fraction } else { 0.01 };
+        let (materials, edge_material) = MaterialTable::build(fabric, form, &angles)
+            .map(|(t, idx)| (t.map_tensile(|l| l.with_linear_toe(toe * l.max_force())), idx))
+            .map_err(|source| ClothError::Material {
                 fabric: fabric.name.clone(),
                 source,
             })?;

@@ -11,12 +11,15 @@
 //! - [`Solver::step`]: one step, with [`StepParams`] and a [`StepReport`] of diagnostics.
 
 pub mod cloth;
+pub mod baselines;
+pub mod metrics;
+pub mod scenes;
 pub mod params;
 pub mod shear;
 pub mod state;
 pub mod step;
 
-pub use cloth::{Cloth, ClothError, Pin, PinMotion};
+pub use cloth::{Cloth, ClothError, ClothOptions, Pin, PinMotion};
 pub use params::{
     ConstraintKind, InternalMethod, ParamError, ShapeMethod, StepParams, TolerancePolicy,
 };

@@ -186,7 +186,6 @@ struct Scratch {
     c: Vec<f64>,
     cdir: Vec<V3>,
     r: Vec<V3>,
-    wsum: Vec<f64>,
     chunk: Vec<f64>,
     cg_x: Vec<f64>,
     cg_r: Vec<f64>,
@@ -252,6 +251,21 @@ impl Solver {
     /// A solver with empty scratch.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Target length of every edge in the last step, m (diagnostics).
+    pub fn last_targets(&self) -> &[f64] {
+        &self.s.target
+    }
+
+    /// Node bending moment M of the last step (thesis (31)), N·m (diagnostics and virtual tests).
+    pub fn last_node_moments(&self) -> &[f64] {
+        &self.s.node_moment
+    }
+
+    /// Curvature of each node's axial slots in the last step, m⁻¹ (diagnostics).
+    pub fn last_curvatures(&self) -> &[[f64; SLOTS]] {
+        &self.s.eta
     }
 
     /// Forget cached estimates (call when switching to a different cloth or changing pins).
@@ -448,7 +462,7 @@ impl Solver {
             resize(v, n, z);
         }
         resize(&mut s.eta, n, [0.0; SLOTS]);
-        for v in [&mut s.node_moment, &mut s.bend_stiffness, &mut s.wsum] {
+        for v in [&mut s.node_moment, &mut s.bend_stiffness] {
             resize(v, n, 0.0);
         }
         resize(&mut s.dir, ne, z);
@@ -526,6 +540,7 @@ impl Solver {
         );
         let pos = &state.positions;
         let hysteresis = params.hysteresis && cloth.bending_hysteretic();
+        let stick = params.bending_stick_slope;
         let s = &mut self.s;
         let normal = &s.normal;
         fill(&mut s.eta, |i| {
@@ -549,10 +564,10 @@ impl Solver {
                     continue;
                 }
                 for k in [k0, k1] {
-                    let spindle = table.bending(mats[i][k]);
+                    let spindle = table.bending(mats[i][k]).with_stick_slope(stick);
                     let l = (pos[axial[i][k] as usize] - pos[i]).norm();
                     let per_width = if hysteresis {
-                        bending_states[i][k].moment(spindle, eta[i][k])
+                        bending_states[i][k].moment(&spindle, eta[i][k])
                     } else {
                         spindle.rigidity() * eta[i][k]
                     };
@@ -703,29 +718,48 @@ impl Solver {
 
     /// One phase of the internal-force solve (thesis (45)–(47)): projected steepest descent, or
     /// the accelerated variant; only this phase's p change. Returns the iterations used.
-    fn internal_phase(
-        &mut self,
-        cloth: &Cloth,
-        params: &StepParams,
-        diagonals: bool,
-        factor: f64,
-    ) -> usize {
+    fn internal_phase(&mut self, cloth: &Cloth, params: &StepParams, diagonals: bool, factor: f64) -> usize {
         let edges = cloth.topology().edges();
         let lambda = self.lambda.map_or(1.0, |l| l[usize::from(diagonals)]);
         let mut gamma = params.internal_step / lambda;
-        let tol = params.internal_tolerance * factor;
         let in_phase = |e: usize| edges[e].kind.is_axial() != diagonals;
-        self.gather(cloth, diagonals);
-        let mut e_old = self.energy(cloth);
-        if e_old == 0.0 {
-            return 0;
+        // Scale of the optimality test: the gradient with all forces zero (the load itself).
+        for e in 0..self.s.p_y.len() {
+            self.s.p_y[e] = if in_phase(e) { 0.0 } else { self.s.p[e] };
         }
+        self.gather_from(cloth, diagonals, true);
+        self.gradient(cloth, diagonals);
+        let g_ref = self.projected_gradient_norm(cloth, diagonals, true);
+        let e_zero = self.energy(cloth);
+        self.gather(cloth, diagonals);
+        let mut e_start = self.energy(cloth);
+        if g_ref == 0.0 || e_start > e_zero {
+            // Nothing to carry, or a warm start worse than no forces at all (the load changed):
+            // start this phase from zero.
+            for (e, p) in self.s.p.iter_mut().enumerate() {
+                if in_phase(e) {
+                    *p = 0.0;
+                }
+            }
+            self.gather(cloth, diagonals);
+            e_start = e_zero;
+            if g_ref == 0.0 {
+                return 0;
+            }
+        }
+        let tol = params.internal_tolerance * factor * g_ref;
+        self.s.p_prev.copy_from_slice(&self.s.p);
+        let warm = self.s.p_prev.clone();
+        let mut e_old = e_start;
         let mut iterations = 0;
         match params.internal_method {
             InternalMethod::SteepestDescent => {
                 while iterations < params.internal_max_iterations {
-                    iterations += 1;
                     self.gradient(cloth, diagonals);
+                    if self.projected_gradient_norm(cloth, diagonals, false) <= tol {
+                        break;
+                    }
+                    iterations += 1;
                     self.s.p_prev.copy_from_slice(&self.s.p);
                     let (grad, p) = (&self.s.grad, &mut self.s.p);
                     for (e, pe) in p.iter_mut().enumerate() {
@@ -743,39 +777,31 @@ impl Solver {
                         self.lambda = None;
                         continue;
                     }
-                    let change = (e_old - e_new) / e_old;
                     e_old = e_new;
-                    if change < tol || e_new == 0.0 {
-                        break;
-                    }
                 }
             }
             InternalMethod::Accelerated => {
                 // FISTA with gradient restart (O'Donoghue & Candès 2015).
-                self.s.p_prev.copy_from_slice(&self.s.p);
                 let mut t: f64 = 1.0;
-                let mut e_y_old = e_old;
                 while iterations < params.internal_max_iterations {
-                    iterations += 1;
                     let t_next = 0.5 * (1.0 + (1.0 + 4.0 * t * t).sqrt());
                     let beta = (t - 1.0) / t_next;
                     {
                         let (p, prev, y) = (&self.s.p, &self.s.p_prev, &mut self.s.p_y);
                         for e in 0..y.len() {
-                            y[e] = if in_phase(e) {
-                                p[e] + beta * (p[e] - prev[e])
-                            } else {
-                                p[e]
-                            };
+                            y[e] = if in_phase(e) { (p[e] + beta * (p[e] - prev[e])).max(0.0) } else { p[e] };
                         }
                     }
                     self.gather_from(cloth, diagonals, true);
-                    let e_y = self.energy(cloth);
                     self.gradient(cloth, diagonals);
+                    if self.projected_gradient_norm(cloth, diagonals, true) <= tol {
+                        self.s.p.copy_from_slice(&self.s.p_y);
+                        break;
+                    }
+                    iterations += 1;
                     let mut restart = 0.0;
                     {
-                        let (p, prev, y, grad) =
-                            (&mut self.s.p, &mut self.s.p_prev, &self.s.p_y, &self.s.grad);
+                        let (p, prev, y, grad) = (&mut self.s.p, &mut self.s.p_prev, &self.s.p_y, &self.s.grad);
                         for e in 0..p.len() {
                             if in_phase(e) {
                                 let new = (y[e] - gamma * grad[e]).max(0.0);
@@ -786,15 +812,13 @@ impl Solver {
                         }
                     }
                     t = if restart > 0.0 { 1.0 } else { t_next };
-                    let change = (e_y_old - e_y).abs() / e_y_old.max(f64::MIN_POSITIVE);
-                    e_y_old = e_y;
-                    if (change < tol && iterations > 2) || e_y == 0.0 {
-                        break;
-                    }
                 }
                 self.gather(cloth, diagonals);
-                if self.energy(cloth) > e_old * (1.0 + 1e-9) {
-                    // Diverged on this geometry: fall back to the warm start and re-estimate.
+                if self.energy(cloth) > e_start * (1.0 + 1e-9) {
+                    // Worse than the warm start (a step too long for this geometry): keep the
+                    // warm start and re-estimate the step next time.
+                    self.s.p.copy_from_slice(&warm);
+                    self.gather(cloth, diagonals);
                     self.lambda = None;
                 }
             }
@@ -802,11 +826,27 @@ impl Solver {
         iterations
     }
 
+    /// Norm of the projected gradient over one phase's edges (components pushing a zero force
+    /// below zero do not count): zero exactly at the constrained minimum. `at_y`: the forces
+    /// are those of the extrapolated point.
+    fn projected_gradient_norm(&self, cloth: &Cloth, diagonals: bool, at_y: bool) -> f64 {
+        let edges = cloth.topology().edges();
+        let p = if at_y { &self.s.p_y } else { &self.s.p };
+        let g = &self.s.grad;
+        (0..edges.len())
+            .filter(|&e| edges[e].kind.is_axial() != diagonals)
+            .map(|e| if p[e] > 0.0 { g[e] } else { g[e].min(0.0) })
+            .map(|x| x * x)
+            .sum::<f64>()
+            .sqrt()
+    }
+
     /// (18): ṙ⁰ = (μṙ + F^m Δt)/(μ + cΔt), with the bending stiffness k added implicitly along
     /// the normal, (μ + cΔt + kΔt²). Pinned nodes take their prescribed velocity.
     fn unconstrained_velocity(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
         let dt = params.dt;
         let (mass, areas) = (cloth.masses(), cloth.topology().node_areas());
+        let axial = cloth.topology().axial_neighbours();
         let implicit = params.implicit_bending && !params.bending_off;
         let s = &mut self.s;
         let (f_m, normal, k_bend) = (&s.f_m, &s.normal, &s.bend_stiffness);
@@ -817,20 +857,39 @@ impl Solver {
             }
             let mu = mass[i];
             let c = params.damping * areas[i];
-            let v = (vel0[i] * mu + f_m[i] * dt) / (mu + c * dt);
-            if implicit && k_bend[i] > 0.0 {
-                let n = normal[i];
-                let vn = (mu * vel0[i].dot(&n) + f_m[i].dot(&n) * dt)
-                    / (mu + c * dt + k_bend[i] * dt * dt);
-                v - n * v.dot(&n) + n * vn
-            } else {
-                v
-            }
+            (vel0[i] * mu + f_m[i] * dt) / (mu + c * dt)
         });
         let t1 = state.time + dt;
         for pin in cloth.pins() {
             let i = pin.node as usize;
             s.vel[i] = (pin.position(t1) - pos[i]) / dt;
+        }
+        if !implicit {
+            return;
+        }
+        // Implicit bending along the normal, linearised and lumped: the stiffness k of a node
+        // acts on the difference between its normal velocity w and its axial neighbours' mean,
+        //   (μ + cΔt + kΔt²) w_i − kΔt² mean_a(n_i·ṙ_a) = μ n_i·ṙ⁰_i + n_i·F Δt,
+        // solved by three Jacobi sweeps. A rigid motion (equal neighbours) feels no k; the
+        // grid-scale mode that limits explicit bending is damped. Statics are unchanged.
+        for _ in 0..3 {
+            let vel = &s.vel;
+            fill(&mut s.vel_hat, |i| {
+                let v = vel[i];
+                if cloth.is_pinned(i) || k_bend[i] <= 0.0 {
+                    return v;
+                }
+                let n = normal[i];
+                let (mut sum, mut count) = (0.0, 0.0);
+                for &a in axial[i].iter().filter(|&&a| a != NO_NODE) {
+                    sum += n.dot(&vel[a as usize]);
+                    count += 1.0;
+                }
+                let (mu, c, k) = (mass[i], params.damping * areas[i], k_bend[i] * dt * dt);
+                let w = (mu * vel0[i].dot(&n) + f_m[i].dot(&n) * dt + k * sum / count) / (mu + c * dt + k);
+                v - n * v.dot(&n) + n * w
+            });
+            std::mem::swap(&mut s.vel, &mut s.vel_hat);
         }
     }
 
@@ -903,7 +962,7 @@ impl Solver {
 
     /// Shape-constraint iterations (49)–(51): predicted positions r + ṙΔt; per edge the error
     /// C = l − l_target (stretch-only edges: only C > 0); per node R = Σ w_i/(w_i + w_a) C d
-    /// and the scaled velocity step ṙ += γ R/(D Δt), D the node's constraint weight; plain
+    /// and the scaled velocity step ṙ += γ R/(n Δt), n the node's constraint count; plain
     /// (Jacobi) or Chebyshev-accelerated. Stops when RMS(R) < ε^e or at the cap.
     fn shape_iterations(
         &mut self,
@@ -965,37 +1024,21 @@ impl Solver {
                 }
                 r
             });
-            fill(&mut s.wsum, |i| {
-                if inv[i] == 0.0 {
-                    return 0.0;
-                }
-                topo.incident_edges(i)
-                    .iter()
-                    .map(|&e| {
-                        let edge = &edges[e as usize];
-                        let other = if edge.a as usize == i { edge.b } else { edge.a };
-                        inv[i] / (inv[i] + inv[other as usize])
-                    })
-                    .sum()
-            });
             let r = &s.r;
             residual = (det_sum(&mut s.chunk, r.len(), |i| r[i].norm_squared()) / free).sqrt();
             if residual < tol {
                 break;
             }
             iterations += 1;
-            // Half the total weight: a node pulled by d equal constraints moves by their mean.
+            // Jacobi averaging: a node moves by γ times the mean of its constraints' corrections.
             if matches!(
                 params.shape_method,
                 ShapeMethod::Jacobi | ShapeMethod::Chebyshev { .. }
             ) {
-                let (vel, wsum, gamma) = (&s.vel, &s.wsum, params.shape_step);
+                let (vel, gamma) = (&s.vel, params.shape_step);
                 fill(&mut s.vel_hat, |i| {
-                    if wsum[i] > 0.0 {
-                        vel[i] + r[i] * (2.0 * gamma / (wsum[i] * dt))
-                    } else {
-                        vel[i]
-                    }
+                    let count = topo.incident_edges(i).len() as f64;
+                    vel[i] + r[i] * (gamma / (count * dt))
                 });
             }
             match params.shape_method {
@@ -1204,7 +1247,7 @@ impl Solver {
             for (i, slots) in state.bending.iter_mut().enumerate() {
                 for (k, st) in slots.iter_mut().enumerate() {
                     if axial[i][k] != NO_NODE {
-                        st.update(table.bending(smats[i][k]), eta[i][k]);
+                        st.update(&table.bending(smats[i][k]).with_stick_slope(params.bending_stick_slope), eta[i][k]);
                     }
                 }
             }

@@ -1,0 +1,272 @@
+//! Baseline cloth solvers the PARTY step is measured against (`method.md` §2, last paragraph):
+//! the same [`Cloth`] (topology, fabric, masses, pins) and [`ClothState`] in, the same state out,
+//! each with its own parameter struct and a common [`BaselineReport`].
+//!
+//! - [`MassSpring`]: the explicit mass-spring model with Verlet integration of Yamada's wet-cloth
+//!   thesis (`method.md` §5: Hooke springs (Y3.6) on the 8-neighbourhood, Verlet (Y3.1));
+//! - [`Xpbd`]: extended position-based dynamics (Macklin, Müller, Chentanez 2016, "XPBD:
+//!   position-based simulation of compliant constrained dynamics") with distance constraints on
+//!   the same edges.
+//!
+//! # Stiffness from the fabric (shared by both baselines)
+//!
+//! A baseline is only a fair comparison if its springs are as stiff as the fabric PARTY
+//! simulates. Both baselines are linear, so each edge gets one stiffness
+//!
+//! `k = W·E/l⁰` (N/m),
+//!
+//! with `l⁰` the edge's rest length, `W` the width it carries ([`Cloth::edge_widths`]: half the
+//! cells beside it, area over length; for a diagonal, whose one cell has two diagonals, that is
+//! exactly cell area / diagonal length / 2) and `E` the **secant** stiffness (force per width
+//! over strain, N/m) of the edge's own tensile loop (its entry in [`Cloth::materials`]: warp or
+//! weft for axial edges, the 45° or 135° bias loop for diagonals) from zero force to a reference
+//! force `f_ref = fraction · f_max` on the loading branch:
+//! `E = f_ref / (φ⁺(f_ref) − φ⁺(0))`, see [`secant_modulus`]. The default fraction is 1 %
+//! (about 4.9 N/m for KES loops with Fm = 500 gf/cm): the force per width of cloth hanging under
+//! its own weight over tens of centimetres (0.1–2 N/m) lies below it, so the springs are about
+//! as stiff as the fabric in the drapes the project simulates. The secant to the apex (Fm/EMT)
+//! would be 5–10 times stiffer for typical (convex, LT ≈ 0.7) KES loops, i.e. unfairly stiff
+//! and needlessly small time steps. Hysteresis and the nonlinearity of the loops are not
+//! modelled by the baselines; that is part of what they are measured for.
+//!
+//! # Bending (optional in both baselines)
+//!
+//! Neither Yamada's model nor plain XPBD cloth has a bending model tied to measured data. When
+//! enabled, both use the same simple isometric bending along grid lines (the quadratic bending of
+//! Bergou et al. 2006 restricted to the grid's axial triples): for every node `i` with both
+//! neighbours `i−1`, `i+1` along u (and likewise v), rest spacings `h₁ = l⁰(i−1,i)`,
+//! `h₂ = l⁰(i,i+1)`, the discrete curvature vector
+//!
+//! `D = a·x_{i−1} + b·x_i + c·x_{i+1}`, `a = 2/(h₁(h₁+h₂))`, `c = 2/(h₂(h₁+h₂))`, `b = −(a+c)`
+//!
+//! (zero for a straight line at any spacing, `|D| ≈ η` the curvature for an isometric bend), with
+//! energy `½·S·B·|D|²`: `S` the node area (`S = h·W`, the strip length and width the node stands
+//! for) and `B` the elastic rigidity of the spindle at that axis (mean of the two slots' entries;
+//! the residual moment M₀ is ignored, as PARTY does with hysteresis off). This is the continuum
+//! bending energy `½ W B η² h` of the strip the node represents. It is not the PARTY bending
+//! force (normal-based curvature, moment differences): duplicating that would make the
+//! comparison pointless. The hinge rests straight; on curved grid lines (annulus rings) it also
+//! carries an in-plane term of the ring's curvature, which the stretch springs resist anyway.
+
+pub mod mass_spring;
+pub mod xpbd;
+
+pub use mass_spring::{MassSpring, MassSpringParams};
+pub use xpbd::{Xpbd, XpbdParams};
+
+use atelier_fabric::{Branch, TensileLoop};
+use atelier_grid::NO_NODE;
+use nalgebra::Vector3;
+
+use crate::cloth::Cloth;
+use crate::params::ParamError;
+use crate::state::ClothState;
+use crate::step::{Stage, StepError};
+
+type V3 = Vector3<f64>;
+
+/// Diagnostics of one baseline step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BaselineReport {
+    /// Solver sweeps over the constraints: substeps × iterations for [`Xpbd`]; 1 (one force
+    /// evaluation) for [`MassSpring`].
+    pub iterations: usize,
+    /// Largest |ε| = |l − l⁰|/l⁰ over all edges (axial and diagonal) after the step.
+    pub max_strain: f64,
+    /// Kinetic energy ½ Σ μ|ṙ|² after the step (pinned nodes included), J.
+    pub kinetic_energy: f64,
+    /// Fastest node after the step, m/s.
+    pub max_speed: f64,
+}
+
+/// The secant stiffness `E = f_ref / (φ⁺(f_ref) − φ⁺(0))` (force per width over strain, N/m) of
+/// a tensile loop's loading branch at the reference force `f_ref = fraction · f_max`.
+///
+/// Falls back to the apex secant [`TensileLoop::secant_stiffness`] when the loop does not strain
+/// at all up to `f_ref` (a vertical first segment), so the result is always finite and positive
+/// for a valid loop and a fraction in (0, 1].
+pub fn secant_modulus(tensile: &TensileLoop, fraction: f64) -> f64 {
+    let f_ref = fraction * tensile.max_force();
+    let strain = tensile.strain(Branch::Loading, f_ref) - tensile.strain(Branch::Loading, 0.0);
+    let e = f_ref / strain;
+    if e.is_finite() && e > 0.0 {
+        e
+    } else {
+        tensile.secant_stiffness()
+    }
+}
+
+/// The spring stiffness `k = W·E/l⁰` (N/m) of every edge of `cloth`, with `E` the secant modulus
+/// of the edge's tensile loop at `fraction` of its apex force (module docs). Allocates; the
+/// baselines fill their own buffers each step instead.
+pub fn spring_stiffnesses(cloth: &Cloth, fraction: f64) -> Vec<f64> {
+    let mut k = Vec::new();
+    fill_stiffness(cloth, fraction, &mut k);
+    k
+}
+
+/// [`spring_stiffnesses`] into a reused buffer (no allocation once sized).
+pub(crate) fn fill_stiffness(cloth: &Cloth, fraction: f64, out: &mut Vec<f64>) {
+    let (edges, mats, widths, table) = (
+        cloth.topology().edges(),
+        cloth.edge_materials(),
+        cloth.edge_widths(),
+        cloth.materials(),
+    );
+    out.clear();
+    out.extend(
+        edges
+            .iter()
+            .zip(mats)
+            .zip(widths)
+            .map(|((e, &m), &w)| w * secant_modulus(table.tensile(m), fraction) / e.rest_length),
+    );
+}
+
+/// One bending hinge along a grid line (module docs): the curvature vector
+/// `D = Σ weights[k]·x[nodes[k]]` and the stiffness `S·B` of the energy `½·S·B·|D|²`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Hinge {
+    /// `i−1`, `i`, `i+1`.
+    pub nodes: [u32; 3],
+    /// `a`, `b`, `c`, m⁻².
+    pub weights: [f64; 3],
+    /// `S·B`, N·m³.
+    pub stiffness: f64,
+}
+
+impl Hinge {
+    /// The curvature vector D at positions `x`, m⁻¹.
+    #[inline]
+    pub fn curvature(&self, x: &[V3]) -> V3 {
+        let [p, q, r] = self.nodes.map(|n| x[n as usize]);
+        p * self.weights[0] + q * self.weights[1] + r * self.weights[2]
+    }
+}
+
+/// The hinges of every node with both neighbours along u, then along v, into a reused buffer.
+pub(crate) fn fill_hinges(cloth: &Cloth, out: &mut Vec<Hinge>) {
+    let topo = cloth.topology();
+    let (axial, axial_edge, smats) = (
+        topo.axial_neighbours(),
+        topo.axial_edges(),
+        cloth.slot_materials(),
+    );
+    let (edges, areas, table) = (topo.edges(), topo.node_areas(), cloth.materials());
+    out.clear();
+    // Slots: +u, −u, +v, −v; a hinge runs from the minus to the plus neighbour.
+    for (plus, minus) in [(0, 1), (2, 3)] {
+        for i in 0..topo.node_count() {
+            let (p, m) = (axial[i][plus], axial[i][minus]);
+            if p == NO_NODE || m == NO_NODE {
+                continue;
+            }
+            let h1 = edges[axial_edge[i][minus] as usize].rest_length;
+            let h2 = edges[axial_edge[i][plus] as usize].rest_length;
+            let a = 2.0 / (h1 * (h1 + h2));
+            let c = 2.0 / (h2 * (h1 + h2));
+            let b = 0.5
+                * (table.bending(smats[i][plus]).rigidity()
+                    + table.bending(smats[i][minus]).rigidity());
+            out.push(Hinge {
+                nodes: [m, i as u32, p],
+                weights: [a, -(a + c), c],
+                stiffness: areas[i] * b,
+            });
+        }
+    }
+}
+
+/// Resize `v` to `n` entries (no allocation when it already has them).
+pub(crate) fn resize<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
+    if v.len() != n {
+        v.clear();
+        v.resize(n, x);
+    }
+}
+
+/// Index of the first vector with a non-finite component.
+pub(crate) fn first_non_finite(v: &[V3]) -> Option<usize> {
+    v.iter()
+        .position(|x| !(x.x.is_finite() && x.y.is_finite() && x.z.is_finite()))
+}
+
+/// Check a parameter against its range (the same error type as [`crate::StepParams`]).
+pub(crate) fn check(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    range: &'static str,
+) -> Result<(), ParamError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError { name, value, range })
+    }
+}
+
+/// The checks shared by every baseline before a step: the state matches the cloth and its
+/// positions and velocities are finite.
+pub(crate) fn check_input(cloth: &Cloth, state: &ClothState) -> Result<(), StepError> {
+    let n = cloth.topology().node_count();
+    for (what, found) in [
+        ("positions", state.positions.len()),
+        ("velocities", state.velocities.len()),
+    ] {
+        if found != n {
+            return Err(StepError::Mismatch {
+                what,
+                expected: n,
+                found,
+            });
+        }
+    }
+    if !state.time.is_finite() {
+        return Err(non_finite(Stage::Input, "time", "node", 0, state.time));
+    }
+    if let Some(i) = first_non_finite(&state.positions) {
+        return Err(non_finite(Stage::Input, "position", "node", i, state.time));
+    }
+    if let Some(i) = first_non_finite(&state.velocities) {
+        return Err(non_finite(Stage::Input, "velocity", "node", i, state.time));
+    }
+    Ok(())
+}
+
+/// A [`StepError::NonFinite`].
+pub(crate) fn non_finite(
+    stage: Stage,
+    quantity: &'static str,
+    location: &'static str,
+    index: usize,
+    time: f64,
+) -> StepError {
+    StepError::NonFinite {
+        stage,
+        quantity,
+        location,
+        index,
+        time,
+    }
+}
+
+/// The report of a committed state.
+pub(crate) fn report(cloth: &Cloth, state: &ClothState, iterations: usize) -> BaselineReport {
+    let pos = &state.positions;
+    let max_strain = cloth
+        .topology()
+        .edges()
+        .iter()
+        .map(|e| ((pos[e.b as usize] - pos[e.a as usize]).norm() / e.rest_length - 1.0).abs())
+        .fold(0.0, f64::max);
+    BaselineReport {
+        iterations,
+        max_strain,
+        kinetic_energy: state.kinetic_energy(cloth),
+        max_speed: state
+            .velocities
+            .iter()
+            .map(|v| v.norm())
+            .fold(0.0, f64::max),
+    }
+}

@@ -1,0 +1,8 @@
+//! Validation scenes of atelier-solver, one binary with a module per scene (run in release mode:
+//! `cargo test --workspace --release`). Each asserts its reference with the tolerance stated.
+
+mod baselines;
+mod common;
+mod drape;
+mod kes;
+mod statics;
