@@ -169,7 +169,14 @@ struct Scratch {
     len: Vec<f64>,
     eta: Vec<[f64; SLOTS]>,
     node_moment: Vec<f64>,
-    bend_stiffness: Vec<f64>,
+    slot_coef: Vec<[f64; SLOTS]>,
+    slot_len: Vec<[f64; SLOTS]>,
+    w: Vec<f64>,
+    w_r: Vec<f64>,
+    w_z: Vec<f64>,
+    w_p: Vec<f64>,
+    w_ap: Vec<f64>,
+    w_dm: Vec<f64>,
     f_sum: Vec<V3>,
     f_m: Vec<V3>,
     p: Vec<f64>,
@@ -336,7 +343,7 @@ impl Solver {
         self.geometry(cloth, state);
         if params.bending_off {
             self.s.f_sum.iter_mut().for_each(|f| *f = V3::zeros());
-            self.s.bend_stiffness.iter_mut().for_each(|k| *k = 0.0);
+            self.s.slot_coef.iter_mut().for_each(|k| *k = [0.0; SLOTS]);
         } else {
             self.bending(cloth, state, params);
         }
@@ -462,9 +469,11 @@ impl Solver {
             resize(v, n, z);
         }
         resize(&mut s.eta, n, [0.0; SLOTS]);
-        for v in [&mut s.node_moment, &mut s.bend_stiffness] {
+        for v in [&mut s.node_moment, &mut s.w, &mut s.w_r, &mut s.w_z, &mut s.w_p, &mut s.w_ap, &mut s.w_dm] {
             resize(v, n, 0.0);
         }
+        resize(&mut s.slot_coef, n, [0.0; SLOTS]);
+        resize(&mut s.slot_len, n, [0.0; SLOTS]);
         resize(&mut s.dir, ne, z);
         resize(&mut s.cdir, ne, z);
         for v in [
@@ -515,12 +524,20 @@ impl Solver {
             (b - a).cross(&(c - a))
         });
         let tn = &s.tri_normal;
+        // A pinned node takes the normal of the clamp it belongs to (its triangles whose nodes
+        // are all pinned), so a clamp imposes its tangent plane on the bending at its edge;
+        // with the free triangles mixed in, the clamp would act half as stiff and the
+        // cantilever converge at first order only (docs/solver.md).
+        let clamped = |t: u32| tris[t as usize].iter().all(|&k| cloth.is_pinned(k as usize));
         fill(&mut s.normal, |i| {
-            let sum: V3 = topo
-                .incident_triangles(i)
-                .iter()
-                .map(|&t| tn[t as usize])
-                .sum();
+            let incident = topo.incident_triangles(i);
+            let mut sum: V3 = V3::zeros();
+            if cloth.is_pinned(i) {
+                sum = incident.iter().filter(|&&t| clamped(t)).map(|&t| tn[t as usize]).sum();
+            }
+            if sum == V3::zeros() {
+                sum = incident.iter().map(|&t| tn[t as usize]).sum();
+            }
             let norm = sum.norm();
             if norm > 0.0 { sum / norm } else { V3::zeros() }
         });
@@ -585,14 +602,30 @@ impl Solver {
                 .sum();
             normal[i] * f
         });
-        fill(&mut s.bend_stiffness, |i| {
-            (0..SLOTS)
-                .filter(|&k| axial[i][k] != NO_NODE)
-                .map(|k| {
+        // Linearised bending for the implicit solve: per slot W·B/2 where the direction has both
+        // neighbours (the node moment counts only those), and the slot length.
+        fill(&mut s.slot_coef, |i| {
+            let mut coef = [0.0; SLOTS];
+            for dir in 0..2 {
+                let (k0, k1) = (2 * dir, 2 * dir + 1);
+                if axial[i][k0] == NO_NODE || axial[i][k1] == NO_NODE {
+                    continue;
+                }
+                for k in [k0, k1] {
                     let l = (pos[axial[i][k] as usize] - pos[i]).norm();
-                    2.0 * areas[i] * table.bending(mats[i][k]).rigidity() / l.powi(4)
-                })
-                .sum()
+                    coef[k] = 0.5 * (areas[i] / l) * table.bending(mats[i][k]).rigidity();
+                }
+            }
+            coef
+        });
+        fill(&mut s.slot_len, |i| {
+            let mut len = [0.0; SLOTS];
+            for k in 0..SLOTS {
+                if axial[i][k] != NO_NODE {
+                    len[k] = (pos[axial[i][k] as usize] - pos[i]).norm();
+                }
+            }
+            len
         });
     }
 
@@ -849,7 +882,7 @@ impl Solver {
         let axial = cloth.topology().axial_neighbours();
         let implicit = params.implicit_bending && !params.bending_off;
         let s = &mut self.s;
-        let (f_m, normal, k_bend) = (&s.f_m, &s.normal, &s.bend_stiffness);
+        let (f_m, normal) = (&s.f_m, &s.normal);
         let (vel0, pos) = (&state.velocities, &state.positions);
         fill(&mut s.vel, |i| {
             if cloth.is_pinned(i) {
@@ -867,29 +900,129 @@ impl Solver {
         if !implicit {
             return;
         }
-        // Implicit bending along the normal, linearised and lumped: the stiffness k of a node
-        // acts on the difference between its normal velocity w and its axial neighbours' mean,
-        //   (μ + cΔt + kΔt²) w_i − kΔt² mean_a(n_i·ṙ_a) = μ n_i·ṙ⁰_i + n_i·F Δt,
-        // solved by three Jacobi sweeps. A rigid motion (equal neighbours) feels no k; the
-        // grid-scale mode that limits explicit bending is damped. Statics are unchanged.
-        for _ in 0..3 {
-            let vel = &s.vel;
-            fill(&mut s.vel_hat, |i| {
-                let v = vel[i];
-                if cloth.is_pinned(i) || k_bend[i] <= 0.0 {
-                    return v;
+        // Implicit bending along the normals, linearised (method §2: explicit bending limits Δt
+        // to ~2√(μ/k), k ≈ 16WB/h³, which scales with h²). Unknowns: the normal speeds w of the
+        // free nodes; (μ + cΔt) w − Δt² K w = (μ + cΔt) n·ṙ_explicit, K the bending stiffness
+        // for normal displacements (the same stencil as the force, with B), solved by
+        // Jacobi-preconditioned CG. Statics are unchanged; rigid motions have K w = 0.
+        let k_apply = |w: &[f64], dm: &mut [f64], out: &mut [f64], s_coef: &[[f64; SLOTS]], s_len: &[[f64; SLOTS]]| {
+            fill(dm, |i| {
+                let mut m = 0.0;
+                for k in 0..SLOTS {
+                    let a = axial[i][k];
+                    if a == NO_NODE || s_coef[i][k] == 0.0 {
+                        continue;
+                    }
+                    let l = s_len[i][k];
+                    let deta = -2.0 * (w[a as usize] * normal[i].dot(&normal[a as usize]) - w[i]) / (l * l);
+                    m += s_coef[i][k] * deta;
                 }
-                let n = normal[i];
-                let (mut sum, mut count) = (0.0, 0.0);
-                for &a in axial[i].iter().filter(|&&a| a != NO_NODE) {
-                    sum += n.dot(&vel[a as usize]);
-                    count += 1.0;
-                }
-                let (mu, c, k) = (mass[i], params.damping * areas[i], k_bend[i] * dt * dt);
-                let w = (mu * vel0[i].dot(&n) + f_m[i].dot(&n) * dt + k * sum / count) / (mu + c * dt + k);
-                v - n * v.dot(&n) + n * w
+                m
             });
-            std::mem::swap(&mut s.vel, &mut s.vel_hat);
+            let dm: &[f64] = dm;
+            fill(out, |i| {
+                let mut f = 0.0;
+                for k in 0..SLOTS {
+                    let a = axial[i][k];
+                    if a != NO_NODE {
+                        f += (dm[a as usize] - dm[i]) / s_len[i][k];
+                    }
+                }
+                f
+            });
+        };
+        let diag = |i: usize| {
+            let (mu, c) = (mass[i], params.damping * areas[i]);
+            // Diagonal of −K: each slot's own δη term through M_i and M_a.
+            let mut k = 0.0;
+            for slot in 0..SLOTS {
+                let a = axial[i][slot];
+                if a == NO_NODE {
+                    continue;
+                }
+                let l = s.slot_len[i][slot];
+                k += 2.0 * s.slot_coef[i][slot] / (l * l) * 3.0 / l;
+            }
+            mu + c * dt + dt * dt * k
+        };
+        let free = |i: usize| !cloth.is_pinned(i);
+        let vel = &s.vel;
+        fill(&mut s.w, |i| normal[i].dot(&vel[i]));
+        // rhs b = (μ + cΔt) w_explicit for free nodes; pinned w stay prescribed (moved to b).
+        k_apply(&s.w, &mut s.w_dm, &mut s.w_ap, &s.slot_coef, &s.slot_len);
+        for i in 0..s.w.len() {
+            let (mu, c) = (mass[i], params.damping * areas[i]);
+            // r = b − A w with w = w_explicit: r = Δt² K w (free nodes).
+            s.w_r[i] = if free(i) { dt * dt * s.w_ap[i] } else { 0.0 };
+            let _ = (mu, c);
+        }
+        // The stencil is not exactly symmetric at free edges and clamps (the thesis's force is
+        // not the gradient of an energy), so the solve is Jacobi-preconditioned BiCGSTAB.
+        let n = s.w.len();
+        let r0: f64 = s.w_r.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if r0 > 0.0 {
+            let apply_a = |x: &[f64], dm: &mut [f64], out: &mut [f64], s_coef: &[[f64; SLOTS]], s_len: &[[f64; SLOTS]]| {
+                k_apply(x, dm, out, s_coef, s_len);
+                for i in 0..x.len() {
+                    let (mu, c) = (mass[i], params.damping * areas[i]);
+                    out[i] = if free(i) { (mu + c * dt) * x[i] - dt * dt * out[i] } else { 0.0 };
+                }
+            };
+            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+            let r_hat = s.w_r.clone();
+            let mut rho = 1.0;
+            let mut alpha = 1.0;
+            let mut omega = 1.0;
+            s.w_p.iter_mut().for_each(|x| *x = 0.0);
+            let mut v = vec![0.0; n];
+            let mut y = vec![0.0; n];
+            let mut z = vec![0.0; n];
+            let mut t = vec![0.0; n];
+            for _ in 0..40 {
+                let rho_new = dot(&r_hat, &s.w_r);
+                if rho_new == 0.0 || omega == 0.0 {
+                    break;
+                }
+                let beta = (rho_new / rho) * (alpha / omega);
+                rho = rho_new;
+                for i in 0..n {
+                    s.w_p[i] = s.w_r[i] + beta * (s.w_p[i] - omega * v[i]);
+                    y[i] = if free(i) { s.w_p[i] / diag(i) } else { 0.0 };
+                }
+                apply_a(&y, &mut s.w_dm, &mut v, &s.slot_coef, &s.slot_len);
+                let rv = dot(&r_hat, &v);
+                if rv == 0.0 || rv.is_nan() {
+                    break;
+                }
+                alpha = rho / rv;
+                for i in 0..n {
+                    s.w[i] += alpha * y[i];
+                    s.w_r[i] -= alpha * v[i];
+                }
+                if dot(&s.w_r, &s.w_r).sqrt() <= 1e-10 * r0 {
+                    break;
+                }
+                for i in 0..n {
+                    z[i] = if free(i) { s.w_r[i] / diag(i) } else { 0.0 };
+                }
+                apply_a(&z, &mut s.w_dm, &mut t, &s.slot_coef, &s.slot_len);
+                let tt = dot(&t, &t);
+                omega = if tt > 0.0 { dot(&t, &s.w_r) / tt } else { 0.0 };
+                for i in 0..n {
+                    s.w[i] += omega * z[i];
+                    s.w_r[i] -= omega * t[i];
+                }
+                if dot(&s.w_r, &s.w_r).sqrt() <= 1e-10 * r0 {
+                    break;
+                }
+            }
+        }
+        let w = &s.w;
+        for (i, v) in s.vel.iter_mut().enumerate() {
+            if free(i) {
+                let n = normal[i];
+                *v += n * (w[i] - n.dot(v));
+            }
         }
     }
 

@@ -2,6 +2,7 @@
 //! `cargo test --workspace --release`). Each asserts its reference with the tolerance stated.
 
 mod baselines;
+mod cantilever;
 mod common;
 mod drape;
 mod kes;

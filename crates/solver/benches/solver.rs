@@ -1,0 +1,552 @@
+//! Benchmarks of the PARTY step (issue 3, "Speed") and of the two baselines.
+//!
+//! Scene: a 1 m × 1 m cotton sheet (`fixtures/fabrics/cotton_broad.ron`) of `n × n` nodes from
+//! [`StructuredGrid::sheet`], horizontal, pinned along its far edge (y = 1 m; it swings down like
+//! a flap), with a smooth seeded vertical perturbation of at most 1 mm on the free nodes (so the
+//! fall is not perfectly symmetric; smooth, so that it is the same shape at every resolution and
+//! puts no grid-scale curvature into the finer sheets), advanced by [`WARM_UP_STEPS`] default steps (Δt 0.01 s) so that the
+//! cloth is moving. Every bench checks the step from that state before timing it (the step
+//! succeeds, the strain error is finite and below [`MAX_STRAIN_ERROR`], the cloth moves).
+//!
+//! Pinned at two corners instead, the 200² sheet (5 mm spacing) is not a fair bench scene with
+//! the default caps: its strain error jumps to 40 % and its top speed to 1.8 m/s in the fifth
+//! step (measured while writing this bench), i.e. the step is no longer an answer worth timing.
+//!
+//! - `party/<nodes>`: one full [`Solver::step`] from the warmed-up state (each iteration starts
+//!   from a clone of the same state, so every iteration does the same work), for 289, 2 704,
+//!   10 000 and 40 000 nodes; throughput in nodes, so criterion also prints nodes per second.
+//! - After each size, [`stage_medians`] steps on from the warmed-up state and takes the median
+//!   of every [`StageTimings`] field, of the iteration counts and of the ns per edge per
+//!   constraint iteration; the table goes to stderr and to
+//!   `$CARGO_TARGET_DIR/atelier-bench/solver_stages.md` (default `target/`).
+//! - `baselines/{party,mass_spring,xpbd}_2704`: the 2 704-node scene with each solver (the
+//!   baselines with their bending hinges on, as PARTY computes bending); the mass-spring step is
+//!   explicit, so its table row also gives the time per 0.01 s of simulated time.
+//!
+//! `cargo test --benches` runs each bench once (criterion's test mode) with one step per stage
+//! median, so CI checks the answers in a few seconds without timing anything.
+
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use atelier_fabric::{AnisotropyForm, Fabric};
+use atelier_grid::{ClothTopology, StructuredGrid};
+use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
+use atelier_solver::{
+    Cloth, ClothState, PinMotion, Solver, StageTimings, StepParams, StepReport,
+};
+use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
+use nalgebra::Vector3;
+
+/// Nodes per side of the benchmarked sheets: 289, 2 704, 10 000 and 40 000 nodes.
+const SIDES: [usize; 4] = [17, 52, 100, 200];
+/// Side of the sheet, m.
+const SHEET_SIZE: f64 = 1.0;
+/// Default steps taken before timing, so that the cloth is moving.
+const WARM_UP_STEPS: usize = 4;
+/// Amplitude of the seeded vertical perturbation of the free nodes, m.
+const PERTURBATION: f64 = 1e-3;
+/// Seed of the perturbation's wave numbers and phases.
+const SEED: u64 = 3;
+/// Number of plane waves in the perturbation.
+const WAVES: usize = 4;
+/// Largest acceptable `max_strain_error` of the checked step. The default caps do not converge
+/// the shape constraints on the finer sheets (the error grows with the node count: about 0.3 %
+/// at 289 nodes, 4 % at 40 000 after the warm-up), so this is a sanity bound, not a tolerance.
+const MAX_STRAIN_ERROR: f64 = 0.1;
+
+/// Whether criterion is measuring (`cargo bench`), not just running each bench once
+/// (`cargo test --benches`, or `cargo bench -- --test`).
+fn measuring() -> bool {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter().any(|a| a == "--bench") && !args.iter().any(|a| a == "--test" || a == "--list")
+}
+
+fn cotton() -> Fabric {
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/fabrics/cotton_broad.ron");
+    Fabric::load(&path).expect("fixture")
+}
+
+/// SplitMix64 in [0, 1) (Steele et al. 2014), for the seeded perturbation.
+fn uniform(n: usize, mut seed: u64) -> Vec<f64> {
+    (0..n)
+        .map(|_| {
+            seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = seed;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^= z >> 31;
+            (z >> 11) as f64 / (1u64 << 53) as f64
+        })
+        .collect()
+}
+
+/// The benchmark scene before any step: the cloth (its far edge pinned) and its perturbed flat
+/// state.
+fn sheet_scene(fabric: &Fabric, side: usize) -> (Cloth, ClothState) {
+    let grid = StructuredGrid::sheet(side, side, SHEET_SIZE, SHEET_SIZE);
+    let topology = ClothTopology::from_structured(&grid).expect("grid");
+    let mut cloth = Cloth::new(topology, fabric, AnisotropyForm::Thesis).expect("cloth");
+    for node in (side - 1) * side..side * side {
+        let [x, y] = grid.positions[node];
+        cloth
+            .pin(node as u32, Vector3::new(x, y, 0.0), PinMotion::Fixed)
+            .expect("pin");
+    }
+    // z = A/WAVES · Σ sin(2π(k_x x + k_y y) + φ) with seeded integer wave numbers 1–3 per
+    // sheet side (wavelengths ≥ 24 cm) and phases: the same smooth shape at every resolution.
+    let u = uniform(3 * WAVES, SEED);
+    let waves: Vec<[f64; 3]> = u
+        .chunks(3)
+        .map(|w| {
+            let k = |x: f64| (1.0 + (3.0 * x).floor()) / SHEET_SIZE;
+            [k(w[0]), k(w[1]), std::f64::consts::TAU * w[2]]
+        })
+        .collect();
+    let mut state = ClothState::flat(&cloth, 0.0);
+    for (i, p) in state.positions.iter_mut().enumerate() {
+        if !cloth.is_pinned(i) {
+            let sum: f64 = waves
+                .iter()
+                .map(|[kx, ky, phase]| {
+                    (std::f64::consts::TAU * (kx * p.x + ky * p.y) + phase).sin()
+                })
+                .sum();
+            p.z += PERTURBATION * sum / WAVES as f64;
+        }
+    }
+    (cloth, state)
+}
+
+/// A PARTY sheet after the warm-up, with the solver that took it there.
+struct Fixture {
+    side: usize,
+    cloth: Cloth,
+    /// State after [`WARM_UP_STEPS`] steps.
+    state: ClothState,
+    solver: Solver,
+    params: StepParams,
+}
+
+impl Fixture {
+    fn new(fabric: &Fabric, side: usize) -> Self {
+        let (cloth, mut state) = sheet_scene(fabric, side);
+        let params = StepParams::default();
+        let mut solver = Solver::new();
+        for _ in 0..WARM_UP_STEPS {
+            solver
+                .step(&cloth, &mut state, &params)
+                .expect("warm-up step");
+        }
+        let fixture = Self {
+            side,
+            cloth,
+            state,
+            solver,
+            params,
+        };
+        fixture.check();
+        fixture
+    }
+
+    fn nodes(&self) -> usize {
+        self.cloth.topology().node_count()
+    }
+
+    fn edges(&self) -> usize {
+        self.cloth.topology().edges().len()
+    }
+
+    /// The answer checked before timing: the next step succeeds, its strain error and
+    /// residuals are finite and small, and the cloth is moving.
+    fn check(&self) {
+        let mut solver = Solver::new();
+        let mut state = self.state.clone();
+        let r = solver
+            .step(&self.cloth, &mut state, &self.params)
+            .unwrap_or_else(|e| panic!("{}² sheet: {e}", self.side));
+        assert!(
+            r.max_strain_error.is_finite() && r.max_strain_error < MAX_STRAIN_ERROR,
+            "{}² sheet: strain error {}",
+            self.side,
+            r.max_strain_error
+        );
+        assert!(r.shape_residual.is_finite() && r.internal_residual.is_finite());
+        assert!(
+            r.max_speed > 0.05,
+            "{}² sheet: not moving ({} m/s)",
+            self.side,
+            r.max_speed
+        );
+        assert!((state.time - (WARM_UP_STEPS + 1) as f64 * self.params.dt).abs() < 1e-9);
+    }
+}
+
+/// Medians of the per-stage wall times of `steps` consecutive steps, and derived rates.
+#[derive(Clone, Copy, Debug, Default)]
+struct StageMedians {
+    nodes: usize,
+    edges: usize,
+    steps: usize,
+    timings: StageTimings,
+    total: Duration,
+    internal_iterations: [f64; 2],
+    shape_iterations: f64,
+    /// Median over the steps of shape time / (edges × shape iterations), ns.
+    ns_per_edge_shape_iteration: f64,
+    /// Median over the steps of internal time / (edges × internal iterations of both phases), ns.
+    ns_per_edge_internal_iteration: f64,
+    max_strain_error: f64,
+}
+
+fn median_f64(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+fn median_duration(reports: &[StepReport], field: impl Fn(&StageTimings) -> Duration) -> Duration {
+    Duration::from_secs_f64(median_f64(
+        reports
+            .iter()
+            .map(|r| field(&r.timings).as_secs_f64())
+            .collect(),
+    ))
+}
+
+/// The stages of [`Solver::step`] are private, but every step reports its wall time per stage
+/// ([`StepReport::timings`]). This helper steps a clone of the fixture's warmed-up state with a
+/// fresh solver (one untimed step first, to size the scratch and estimate the internal step
+/// size), then records `steps` consecutive steps and takes the median of each timing field, of
+/// the iteration counts and of the per-step costs per edge and iteration: shape time / (edges ×
+/// shape iterations), internal time / (edges × internal iterations, both phases). Medians of
+/// the fields are taken separately, so they need not add up to the median total.
+fn stage_medians(fixture: &Fixture, steps: usize) -> StageMedians {
+    let mut solver = Solver::new();
+    let mut state = fixture.state.clone();
+    let (cloth, params) = (&fixture.cloth, &fixture.params);
+    solver.step(cloth, &mut state, params).expect("step");
+    let reports: Vec<StepReport> = (0..steps)
+        .map(|_| solver.step(cloth, &mut state, params).expect("step"))
+        .collect();
+    let edges = fixture.edges();
+    let per_edge_iteration = |time: Duration, iterations: usize| {
+        if iterations == 0 {
+            f64::NAN
+        } else {
+            time.as_secs_f64() * 1e9 / (edges * iterations) as f64
+        }
+    };
+    StageMedians {
+        nodes: fixture.nodes(),
+        edges,
+        steps,
+        timings: StageTimings {
+            bending: median_duration(&reports, |t| t.bending),
+            internal: median_duration(&reports, |t| t.internal),
+            velocity: median_duration(&reports, |t| t.velocity),
+            shape: median_duration(&reports, |t| t.shape),
+            collision: median_duration(&reports, |t| t.collision),
+            update: median_duration(&reports, |t| t.update),
+        },
+        total: median_duration(&reports, |t| t.total()),
+        internal_iterations: [0, 1].map(|k| {
+            median_f64(
+                reports
+                    .iter()
+                    .map(|r| r.internal_iterations[k] as f64)
+                    .collect(),
+            )
+        }),
+        shape_iterations: median_f64(
+            reports.iter().map(|r| r.shape_iterations as f64).collect(),
+        ),
+        ns_per_edge_shape_iteration: median_f64(
+            reports
+                .iter()
+                .map(|r| per_edge_iteration(r.timings.shape, r.shape_iterations))
+                .collect(),
+        ),
+        ns_per_edge_internal_iteration: median_f64(
+            reports
+                .iter()
+                .map(|r| {
+                    per_edge_iteration(
+                        r.timings.internal,
+                        r.internal_iterations[0] + r.internal_iterations[1],
+                    )
+                })
+                .collect(),
+        ),
+        max_strain_error: reports
+            .iter()
+            .map(|r| r.max_strain_error)
+            .fold(0.0, f64::max),
+    }
+}
+
+fn ms(d: Duration) -> String {
+    format!("{:.3}", d.as_secs_f64() * 1e3)
+}
+
+const STAGE_HEADER: &str = "| nodes | edges | steps | total ms | steps/s | bending ms | internal ms | velocity ms | shape ms | collision ms | update ms | internal it (axial+diag) | shape it | ns/(edge·shape it) | ns/(edge·internal it) | max strain err |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+
+impl StageMedians {
+    fn row(&self) -> String {
+        let t = &self.timings;
+        format!(
+            "| {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {:.0}+{:.0} | {:.0} | {:.2} | {:.2} | {:.1e} |\n",
+            self.nodes,
+            self.edges,
+            self.steps,
+            ms(self.total),
+            1.0 / self.total.as_secs_f64(),
+            ms(t.bending),
+            ms(t.internal),
+            ms(t.velocity),
+            ms(t.shape),
+            ms(t.collision),
+            ms(t.update),
+            self.internal_iterations[0],
+            self.internal_iterations[1],
+            self.shape_iterations,
+            self.ns_per_edge_shape_iteration,
+            self.ns_per_edge_internal_iteration,
+            self.max_strain_error,
+        )
+    }
+}
+
+/// Median wall time per step of `step` over `steps` calls (after one untimed call).
+fn median_step_time(steps: usize, mut step: impl FnMut()) -> Duration {
+    step();
+    let times = (0..steps)
+        .map(|_| {
+            let t0 = Instant::now();
+            step();
+            t0.elapsed().as_secs_f64()
+        })
+        .collect();
+    Duration::from_secs_f64(median_f64(times))
+}
+
+/// Where the tables go: `$CARGO_TARGET_DIR/atelier-bench/`, default the workspace's `target/`.
+fn report_path(name: &str) -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"));
+    target.join("atelier-bench").join(name)
+}
+
+fn write_report(name: &str, text: &str) {
+    let path = report_path(name);
+    let written = path
+        .parent()
+        .map_or(Ok(()), std::fs::create_dir_all)
+        .and_then(|()| std::fs::write(&path, text));
+    match written {
+        Ok(()) => eprintln!("wrote {}", path.display()),
+        Err(e) => eprintln!("could not write {}: {e}", path.display()),
+    }
+}
+
+fn party(c: &mut Criterion) {
+    let fabric = cotton();
+    let measuring = measuring();
+    let mut rows = Vec::new();
+    let mut g = c.benchmark_group("party");
+    for side in SIDES {
+        let nodes = side * side;
+        let large = nodes >= 10_000;
+        g.throughput(Throughput::Elements(nodes as u64));
+        g.sample_size(if large { 10 } else { 20 });
+        g.warm_up_time(Duration::from_secs(if large { 2 } else { 1 }));
+        g.measurement_time(Duration::from_secs(if large { 15 } else { 5 }));
+        // Built on first use, so a filtered run does not pay for the other sizes.
+        let mut fixture: Option<Fixture> = None;
+        g.bench_function(nodes.to_string(), |b| {
+            let fx = fixture.get_or_insert_with(|| Fixture::new(&fabric, side));
+            let (cloth, params) = (&fx.cloth, &fx.params);
+            let (start, solver) = (&fx.state, &mut fx.solver);
+            b.iter_batched(
+                || start.clone(),
+                |mut state| solver.step(cloth, &mut state, params).expect("step"),
+                BatchSize::LargeInput,
+            )
+        });
+        if let Some(fx) = &fixture {
+            let steps = if !measuring {
+                1
+            } else if large {
+                10
+            } else {
+                30
+            };
+            let m = stage_medians(fx, steps);
+            eprintln!("party/{nodes} stage medians:\n{STAGE_HEADER}{}", m.row());
+            rows.push(m.row());
+        }
+    }
+    g.finish();
+    if !rows.is_empty() {
+        let mut text = String::from(
+            "# PARTY step: per-stage medians (benches/solver.rs, `stage_medians`)\n\n",
+        );
+        let _ = writeln!(
+            text,
+            "Scene: {SHEET_SIZE} m cotton sheet pinned along one edge, after {WARM_UP_STEPS} \
+             steps of Δt 0.01 s; default StepParams.\n"
+        );
+        text.push_str(STAGE_HEADER);
+        rows.iter().for_each(|r| text.push_str(r));
+        write_report("solver_stages.md", &text);
+    }
+}
+
+/// The baselines on the 2 704-node scene, warmed up for the same simulated time as PARTY.
+fn baselines(c: &mut Criterion) {
+    const SIDE: usize = 52;
+    let fabric = cotton();
+    let measuring = measuring();
+    let warm_up_time = WARM_UP_STEPS as f64 * StepParams::default().dt;
+    let (cloth, start) = sheet_scene(&fabric, SIDE);
+    let nodes = cloth.topology().node_count();
+
+    // PARTY, for the ratio on the same scene.
+    let party = Fixture::new(&fabric, SIDE);
+
+    // Mass-spring Verlet at 0.9 × its estimated stability limit (a safe lower bound of the
+    // true limit), rounded down to a whole number of steps per warm-up.
+    let mut ms_params = MassSpringParams {
+        bending: true,
+        ..MassSpringParams::default()
+    };
+    let limit = MassSpring::largest_stable_dt_estimate(&cloth, &ms_params);
+    let ms_steps = (warm_up_time / (0.9 * limit)).ceil() as usize;
+    ms_params.dt = warm_up_time / ms_steps as f64;
+    let mut ms_state = start.clone();
+    let mut ms_solver = MassSpring::new();
+    for _ in 0..ms_steps {
+        ms_solver
+            .step(&cloth, &mut ms_state, &ms_params)
+            .expect("mass-spring warm-up");
+    }
+    {
+        let (mut s, mut st) = (ms_solver.clone(), ms_state.clone());
+        let r = s.step(&cloth, &mut st, &ms_params).expect("mass-spring step");
+        assert!(r.max_strain.is_finite() && r.max_strain < 0.2, "{r:?}");
+        assert!(r.max_speed > 0.05, "mass-spring not moving: {r:?}");
+    }
+
+    // XPBD, defaults (Δt 0.01 s, 10 substeps × 4 sweeps).
+    let xp_params = XpbdParams {
+        bending: true,
+        ..XpbdParams::default()
+    };
+    let mut xp_state = start.clone();
+    let mut xp_solver = Xpbd::new();
+    for _ in 0..WARM_UP_STEPS {
+        xp_solver
+            .step(&cloth, &mut xp_state, &xp_params)
+            .expect("xpbd warm-up");
+    }
+    {
+        let (mut s, mut st) = (xp_solver.clone(), xp_state.clone());
+        let r = s.step(&cloth, &mut st, &xp_params).expect("xpbd step");
+        assert!(r.max_strain.is_finite() && r.max_strain < 0.2, "{r:?}");
+        assert!(r.max_speed > 0.05, "xpbd not moving: {r:?}");
+    }
+
+    let mut g = c.benchmark_group("baselines");
+    g.throughput(Throughput::Elements(nodes as u64));
+    g.sample_size(20);
+    g.measurement_time(Duration::from_secs(5));
+    {
+        let mut solver = Solver::new();
+        let params = &party.params;
+        g.bench_function(format!("party_{nodes}"), |b| {
+            b.iter_batched(
+                || party.state.clone(),
+                |mut state| solver.step(&party.cloth, &mut state, params).expect("step"),
+                BatchSize::LargeInput,
+            )
+        });
+    }
+    g.bench_function(format!("mass_spring_{nodes}"), |b| {
+        b.iter_batched(
+            || (ms_solver.clone(), ms_state.clone()),
+            |(mut s, mut state)| {
+                black_box(s.step(&cloth, &mut state, &ms_params).expect("step"));
+                (s, state)
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.bench_function(format!("xpbd_{nodes}"), |b| {
+        b.iter_batched(
+            || (xp_solver.clone(), xp_state.clone()),
+            |(mut s, mut state)| {
+                black_box(s.step(&cloth, &mut state, &xp_params).expect("step"));
+                (s, state)
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+
+    // Medians per step and per 0.01 s of simulated time, all three on the same scene.
+    let steps = if measuring { 50 } else { 1 };
+    let party_step = {
+        let mut solver = Solver::new();
+        let mut state = party.state.clone();
+        median_step_time(steps, || {
+            black_box(solver.step(&party.cloth, &mut state, &party.params).expect("step"));
+        })
+    };
+    let ms_step = {
+        let (mut s, mut state) = (ms_solver.clone(), ms_state.clone());
+        median_step_time(steps * 20, || {
+            black_box(s.step(&cloth, &mut state, &ms_params).expect("step"));
+        })
+    };
+    let xp_step = {
+        let (mut s, mut state) = (xp_solver.clone(), xp_state.clone());
+        median_step_time(steps, || {
+            black_box(s.step(&cloth, &mut state, &xp_params).expect("step"));
+        })
+    };
+    let per_centisecond = |step: Duration, dt: f64| step.mul_f64(0.01 / dt);
+    let mut text = format!(
+        "# Baselines on the {nodes}-node sheet (benches/solver.rs)\n\n\
+         Mass-spring Δt = {:.3e} s (estimated stability limit {:.3e} s); XPBD Δt 0.01 s, {} \
+         substeps × {} sweeps; PARTY defaults. Medians of {steps} steps.\n\n\
+         | solver | Δt s | ms per step | ms per 0.01 s simulated | vs PARTY |\n|---|---|---|---|---|\n",
+        ms_params.dt, limit, xp_params.substeps, xp_params.iterations,
+    );
+    let party_cs = per_centisecond(party_step, party.params.dt);
+    for (name, step, dt) in [
+        ("PARTY", party_step, party.params.dt),
+        ("mass-spring Verlet", ms_step, ms_params.dt),
+        ("XPBD", xp_step, xp_params.dt),
+    ] {
+        let cs = per_centisecond(step, dt);
+        let _ = writeln!(
+            text,
+            "| {name} | {dt:.3e} | {} | {} | {:.2} |",
+            ms(step),
+            ms(cs),
+            cs.as_secs_f64() / party_cs.as_secs_f64()
+        );
+    }
+    eprintln!("{text}");
+    write_report("solver_baselines.md", &text);
+}
+
+criterion_group!(benches, party, baselines);
+criterion_main!(benches);
