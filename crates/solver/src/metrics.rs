@@ -20,6 +20,8 @@
 //!   along the outline, smoothed with a periodic Gaussian, its local maxima counted when their
 //!   topographic prominence reaches a threshold ([`NodeCountParams`]).
 
+use std::cmp::Ordering;
+
 use nalgebra::Vector3;
 
 /// Scanline rows of [`projected_area`] (over the shape's extent in y).
@@ -215,7 +217,7 @@ pub fn smooth_periodic(profile: &[f64], sigma: f64) -> Vec<f64> {
         return Vec::new();
     }
     let sigma_samples = sigma * n as f64 / std::f64::consts::TAU;
-    if !(sigma_samples >= 0.1) {
+    if sigma_samples.is_nan() || sigma_samples < 0.1 {
         return profile.to_vec();
     }
     let half = ((4.0 * sigma_samples).ceil() as usize).min(n / 2);
@@ -249,17 +251,17 @@ pub fn fold_peaks(profile: &[f64], params: &NodeCountParams) -> Vec<FoldPeak> {
     let mut peaks = Vec::new();
     for i in 0..n {
         let prev = s[(i + n - 1) % n];
-        if !(s[i] > prev) {
+        if s[i].partial_cmp(&prev) != Some(Ordering::Greater) {
             continue;
         }
         // Walk over a plateau; a peak if the first different value after it is lower.
         let mut j = (i + 1) % n;
         let mut steps = 0;
-        while s[j] == s[i] && steps < n {
+        while s[j].total_cmp(&s[i]).is_eq() && steps < n {
             j = (j + 1) % n;
             steps += 1;
         }
-        if !(s[j] < s[i]) {
+        if s[j].partial_cmp(&s[i]) != Some(Ordering::Less) {
             continue;
         }
         // Lowest point on each side before a strictly higher point.

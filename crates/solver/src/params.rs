@@ -90,7 +90,7 @@ pub struct StepParams {
     pub internal_step: f64,
     /// ε^c: stop the internal-force iterations when the projected gradient of E falls below ε^c
     /// times its value with all forces zero (the thesis stops on E's relative change, which
-    /// stalls when E cannot reach zero; see `docs/solver.md`). Range (0, 1); default 1e-6.
+    /// stalls when E cannot reach zero; see `docs/solver.md`). Range (0, 1); default 1e-4.
     pub internal_tolerance: f64,
     /// Iteration cap for the internal forces. Range ≥ 1; default 200.
     pub internal_max_iterations: usize,
@@ -125,6 +125,10 @@ pub struct StepParams {
     pub bending_stick_slope: f64,
     /// Skip bending entirely (an inextensible chain or membrane). Default false.
     pub bending_off: bool,
+    /// Divergence guard: a step whose result stretches or shrinks any edge by more than this
+    /// strain (|l/l⁰ − 1|) fails with `StepError::Diverged` and keeps the state. Range > 0;
+    /// default 1 (a doubled edge: far beyond any fabric's EMT).
+    pub divergence_strain: f64,
     /// Track hysteresis (tensile minor loops, bending spindle) when the fabric has it. Default
     /// true; false uses the loading branch and the elastic spindle centre line.
     pub hysteresis: bool,
@@ -138,7 +142,7 @@ impl Default for StepParams {
             damping: 0.2,
             internal_method: InternalMethod::Accelerated,
             internal_step: 1.0,
-            internal_tolerance: 1e-6,
+            internal_tolerance: 1e-4,
             internal_max_iterations: 200,
             shape_method: ShapeMethod::Chebyshev { rho: 0.99 },
             shape_step: 1.0,
@@ -151,6 +155,7 @@ impl Default for StepParams {
             implicit_bending: true,
             bending_stick_slope: 4.0,
             bending_off: false,
+            divergence_strain: 1.0,
             hysteresis: true,
         }
     }

@@ -64,6 +64,18 @@ pub enum StepError {
         /// The state's count.
         found: usize,
     },
+    /// The step would stretch an edge beyond `StepParams::divergence_strain`.
+    #[error("diverging: edge {edge} would reach strain {strain:.3} (limit {limit}) at time {time} s; Δt too large or tolerances too loose")]
+    Diverged {
+        /// The edge.
+        edge: usize,
+        /// Its strain |l/l⁰ − 1| after the step.
+        strain: f64,
+        /// The limit.
+        limit: f64,
+        /// Simulated time at the start of the step.
+        time: f64,
+    },
     /// A value became NaN or infinite.
     #[error("non-finite {quantity} at {location} {index} in stage {stage:?} (time {time} s)")]
     NonFinite {
@@ -434,6 +446,22 @@ impl Solver {
         fill(&mut self.s.pred, |i| positions[i] + vel[i] * dt);
         if let Some(i) = first_non_finite_v(&self.s.pred) {
             return Err(non_finite(Stage::Update, "position", "node", i));
+        }
+        {
+            let (edges, pred) = (cloth.topology().edges(), &self.s.pred);
+            let worst = edges
+                .iter()
+                .enumerate()
+                .map(|(e, edge)| (e, ((pred[edge.b as usize] - pred[edge.a as usize]).norm() / edge.rest_length - 1.0).abs()))
+                .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+            if worst.1 > params.divergence_strain {
+                return Err(StepError::Diverged {
+                    edge: worst.0,
+                    strain: worst.1,
+                    limit: params.divergence_strain,
+                    time: state.time,
+                });
+            }
         }
         std::mem::swap(&mut state.positions, &mut self.s.pred);
         state.velocities.copy_from_slice(&self.s.vel);

@@ -5,5 +5,6 @@ mod baselines;
 mod cantilever;
 mod common;
 mod drape;
+mod hanging;
 mod kes;
 mod statics;
