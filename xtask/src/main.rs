@@ -2,11 +2,14 @@
 //!
 //! - `cargo xtask figures fabric [--out DIR]` — the fabric-model figures (tensile minor loops,
 //!   bending loop, polar plots of the orthotropic interpolation), PNG, written atomically.
+//! - `cargo xtask figures solver [--out DIR]` — time against error of the PARTY step and the
+//!   baselines on the thesis's drape (PNG and a markdown table, also printed to stdout).
 
 mod figures_fabric;
+mod figures_solver;
 mod plot;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use clap::{Parser, Subcommand, ValueEnum};
@@ -34,6 +37,8 @@ enum Command {
 enum FigureSet {
     /// Tensile and bending hysteresis, orthotropic interpolation.
     Fabric,
+    /// Time against error of the PARTY step and the baselines (takes a few minutes).
+    Solver,
 }
 
 fn repository_root() -> PathBuf {
@@ -43,16 +48,18 @@ fn repository_root() -> PathBuf {
 fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
-        Command::Figures { which, out } => match which {
-            FigureSet::Fabric => {
-                let out = out.unwrap_or_else(|| repository_root().join("figures/fabric"));
-                std::fs::create_dir_all(&out)?;
-                plot::register_font()?;
-                for written in figures_fabric::draw_all(&repository_root(), &out)? {
-                    eprintln!("wrote {}", written.display());
-                }
+        Command::Figures { which, out } => {
+            let (name, draw_all): (&str, fn(&Path, &Path) -> Result<Vec<PathBuf>>) = match which {
+                FigureSet::Fabric => ("fabric", figures_fabric::draw_all),
+                FigureSet::Solver => ("solver", figures_solver::draw_all),
+            };
+            let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
+            std::fs::create_dir_all(&out)?;
+            plot::register_font()?;
+            for written in draw_all(&repository_root(), &out)? {
+                eprintln!("wrote {}", written.display());
             }
-        },
+        }
     }
     Ok(())
 }

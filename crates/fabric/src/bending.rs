@@ -30,6 +30,8 @@ pub struct Spindle {
     /// Largest tangent of the initial and reversal curves as a multiple of B (∞: the exact
     /// square roots, infinitely steep at every turning point).
     stick_slope: f64,
+    /// Curvature band (m⁻¹) within which moving back does not count as a reversal.
+    deadband: f64,
 }
 
 impl Spindle {
@@ -59,6 +61,7 @@ impl Spindle {
             rigidity,
             residual_moment,
             stick_slope: f64::INFINITY,
+            deadband: 0.0,
         })
     }
 
@@ -80,6 +83,22 @@ impl Spindle {
     pub fn with_stick_slope(mut self, slope: f64) -> Self {
         self.stick_slope = if slope > 1.0 { slope } else { f64::INFINITY };
         self
+    }
+
+    /// The same characteristic with a reversal dead band: a change of direction counts as a
+    /// turning point only once the curvature has moved back by more than `band` (m⁻¹) from its
+    /// extreme; smaller excursions run back along the current curve. Without it, the jitter of an
+    /// iterative solver turns every step into a tiny minor loop, and since the model has no
+    /// return-point memory the loop collapses towards the centre line (measured in
+    /// `docs/solver.md`). Negative or NaN bands are treated as 0.
+    pub fn with_deadband(mut self, band: f64) -> Self {
+        self.deadband = if band > 0.0 { band } else { 0.0 };
+        self
+    }
+
+    /// The reversal dead band, m⁻¹.
+    pub fn deadband(&self) -> f64 {
+        self.deadband
     }
 
     /// The regularisation slope (multiple of B), ∞ when exact.
@@ -140,7 +159,8 @@ impl Spindle {
         let eight_mb = 8.0 * self.residual_moment * self.rigidity;
         // Within the regularised chord (slope s·B against the branch's B) the crossing is linear.
         if self.stick_slope.is_finite() {
-            let chord_end = 8.0 * self.residual_moment / (self.stick_slope * self.stick_slope * self.rigidity);
+            let chord_end =
+                8.0 * self.residual_moment / (self.stick_slope * self.stick_slope * self.rigidity);
             let linear = a / ((self.stick_slope - 1.0) * self.rigidity);
             if linear <= chord_end {
                 return linear;
@@ -245,11 +265,16 @@ impl BendingState {
     #[inline]
     fn advance(&self, s: &Spindle, eta: f64) -> (Self, f64) {
         let prev = self.curvature;
-        let reverses = match self.mode {
+        let backwards = match self.mode {
             Mode::Virgin => (prev > 0.0 && eta < prev) || (prev < 0.0 && eta > prev),
             Mode::Rising => eta < prev,
             Mode::Falling => eta > prev,
         };
+        if backwards && (eta - prev).abs() <= s.deadband {
+            // Inside the dead band: back along the current curve, the extreme kept.
+            return (*self, self.eval(s, eta));
+        }
+        let reverses = backwards;
         if !reverses {
             let next = Self {
                 curvature: eta,
@@ -487,7 +512,10 @@ mod tests {
         let mut st = BendingState::VIRGIN;
         st.update(&s, 150.0);
         st.update(&s, 149.0);
-        let (m1, m2) = (st.branch_moment(&s, 150.0 - 1e-6), st.branch_moment(&s, 150.0 - 2e-6));
+        let (m1, m2) = (
+            st.branch_moment(&s, 150.0 - 1e-6),
+            st.branch_moment(&s, 150.0 - 2e-6),
+        );
         assert!(((m1 - m2) / 1e-6).abs() <= 4.0 * b * (1.0 + 1e-9));
         // Far from turning points the loop is unchanged: the KES cycle gives B and 2HB.
         let t = kes_bending_test(&s, 200);
@@ -497,7 +525,11 @@ mod tests {
         let mut st = BendingState::VIRGIN;
         st.update(&s, 200.0);
         let span = 2.0 * s.residual_moment() / b;
-        assert_relative_eq!(st.moment(&s, 200.0 - span), s.falling_branch(200.0 - span), max_relative = 1e-9);
+        assert_relative_eq!(
+            st.moment(&s, 200.0 - span),
+            s.falling_branch(200.0 - span),
+            max_relative = 1e-9
+        );
         assert_eq!(cotton().with_stick_slope(0.5).stick_slope(), f64::INFINITY);
     }
 }

@@ -270,7 +270,7 @@ impl Fabric {
                 .zip(tables.iter_mut())
             {
                 let v = anisotropy::interpolate(
-                    form,
+                    form.for_tensile(),
                     theta,
                     d.warp.strain(branch, f),
                     d.weft.strain(branch, f),
@@ -339,7 +339,7 @@ impl Fabric {
             )
         };
         let b = anisotropy::interpolate(
-            form,
+            form.for_bending(),
             theta,
             d.warp.rigidity(),
             d.weft.rigidity(),
@@ -347,7 +347,7 @@ impl Fabric {
         )
         .ok_or_else(|| undefined("rigidity"))?;
         let m0 = anisotropy::interpolate(
-            form,
+            form.for_bending(),
             theta,
             d.warp.residual_moment(),
             d.weft.residual_moment(),

@@ -34,9 +34,7 @@ use std::time::{Duration, Instant};
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
-use atelier_solver::{
-    Cloth, ClothState, PinMotion, Solver, StageTimings, StepParams, StepReport,
-};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StageTimings, StepParams, StepReport};
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::Vector3;
 
@@ -264,9 +262,7 @@ fn stage_medians(fixture: &Fixture, steps: usize) -> StageMedians {
                     .collect(),
             )
         }),
-        shape_iterations: median_f64(
-            reports.iter().map(|r| r.shape_iterations as f64).collect(),
-        ),
+        shape_iterations: median_f64(reports.iter().map(|r| r.shape_iterations as f64).collect()),
         ns_per_edge_shape_iteration: median_f64(
             reports
                 .iter()
@@ -439,7 +435,9 @@ fn baselines(c: &mut Criterion) {
     }
     {
         let (mut s, mut st) = (ms_solver.clone(), ms_state.clone());
-        let r = s.step(&cloth, &mut st, &ms_params).expect("mass-spring step");
+        let r = s
+            .step(&cloth, &mut st, &ms_params)
+            .expect("mass-spring step");
         assert!(r.max_strain.is_finite() && r.max_strain < 0.2, "{r:?}");
         assert!(r.max_speed > 0.05, "mass-spring not moving: {r:?}");
     }
@@ -506,7 +504,11 @@ fn baselines(c: &mut Criterion) {
         let mut solver = Solver::new();
         let mut state = party.state.clone();
         median_step_time(steps, || {
-            black_box(solver.step(&party.cloth, &mut state, &party.params).expect("step"));
+            black_box(
+                solver
+                    .step(&party.cloth, &mut state, &party.params)
+                    .expect("step"),
+            );
         })
     };
     let ms_step = {

@@ -100,12 +100,30 @@ pub struct Cloth {
     inv_mass: Vec<f64>,
     pins: Vec<Pin>,
     pin_of: Vec<u32>,
+    incidence_offsets: Vec<u32>,
+    incidence: Vec<Incidence>,
+}
+
+/// One edge as seen from one of its nodes, for gathers without indirection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Incidence {
+    /// Edge index.
+    pub edge: u32,
+    /// The edge's other node.
+    pub other: u32,
+    /// +1 when this node is the edge's first node (the edge direction points away from it).
+    pub sign: f64,
+    /// This node's share of a correction on the edge, w_i/(w_i + w_other) (0 when pinned).
+    pub share: f64,
+    /// Whether the edge is axial (4-neighbourhood).
+    pub axial: bool,
 }
 
 /// How a fabric is turned into a cloth's materials.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ClothOptions {
-    /// Orthotropic interpolation law. Default `Thesis`.
+    /// Orthotropic interpolation law. Default `PlateTheory` (the thesis form can invert a
+    /// tensile loop at angles between the measured ones; see `docs/fabric.md`).
     pub form: AnisotropyForm,
     /// Linear toe of every tensile loop below this fraction of its maximum force
     /// (`TensileLoop::with_linear_toe`): a finite initial modulus instead of the synthetic
@@ -118,7 +136,7 @@ pub struct ClothOptions {
 impl Default for ClothOptions {
     fn default() -> Self {
         Self {
-            form: AnisotropyForm::Thesis,
+            form: AnisotropyForm::PlateTheory,
             toe_fraction: 0.01,
         }
     }
@@ -127,17 +145,41 @@ impl Default for ClothOptions {
 impl Cloth {
     /// Build a cloth from a topology and a fabric with the default [`ClothOptions`] and the
     /// given anisotropy form.
-    pub fn new(topology: ClothTopology, fabric: &Fabric, form: AnisotropyForm) -> Result<Self, ClothError> {
-        Self::with_options(topology, fabric, ClothOptions { form, ..ClothOptions::default() })
+    pub fn new(
+        topology: ClothTopology,
+        fabric: &Fabric,
+        form: AnisotropyForm,
+    ) -> Result<Self, ClothError> {
+        Self::with_options(
+            topology,
+            fabric,
+            ClothOptions {
+                form,
+                ..ClothOptions::default()
+            },
+        )
     }
 
     /// Build a cloth, interpolating the fabric to every distinct edge angle once.
-    pub fn with_options(topology: ClothTopology, fabric: &Fabric, options: ClothOptions) -> Result<Self, ClothError> {
+    pub fn with_options(
+        topology: ClothTopology,
+        fabric: &Fabric,
+        options: ClothOptions,
+    ) -> Result<Self, ClothError> {
         let form = options.form;
         let angles: Vec<f64> = topology.edges().iter().map(|e| e.material_angle).collect();
-        let toe = if (0.0..1.0).contains(&options.toe_fraction) { options.toe_fraction } else { 0.01 };
+        let toe = if (0.0..1.0).contains(&options.toe_fraction) {
+            options.toe_fraction
+        } else {
+            0.01
+        };
         let (materials, edge_material) = MaterialTable::build(fabric, form, &angles)
-            .map(|(t, idx)| (t.map_tensile(|l| l.with_linear_toe(toe * l.max_force())), idx))
+            .map(|(t, idx)| {
+                (
+                    t.map_tensile(|l| l.with_linear_toe(toe * l.max_force())),
+                    idx,
+                )
+            })
             .map_err(|source| ClothError::Material {
                 fabric: fabric.name.clone(),
                 source,
@@ -204,7 +246,10 @@ impl Cloth {
             inv_mass,
             pins: Vec::new(),
             pin_of: vec![NO_NODE; n],
-        })
+            incidence_offsets: Vec::new(),
+            incidence: Vec::new(),
+        }
+        .with_incidence())
     }
 
     /// Pin `node` at `anchor` with `motion` (re-pinning a node replaces its pin).
@@ -242,7 +287,70 @@ impl Cloth {
             k => self.pins[k as usize] = pin,
         }
         self.inv_mass[node as usize] = 0.0;
+        self.update_shares(node as usize);
         Ok(())
+    }
+
+    fn with_incidence(mut self) -> Self {
+        let topo = &self.topology;
+        let n = topo.node_count();
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut list = Vec::with_capacity(2 * topo.edges().len());
+        offsets.push(0);
+        for i in 0..n {
+            for &e in topo.incident_edges(i) {
+                let edge = topo.edges()[e as usize];
+                let (other, sign) = if edge.a as usize == i {
+                    (edge.b, 1.0)
+                } else {
+                    (edge.a, -1.0)
+                };
+                list.push(Incidence {
+                    edge: e,
+                    other,
+                    sign,
+                    share: 0.0,
+                    axial: edge.kind.is_axial(),
+                });
+            }
+            offsets.push(list.len() as u32);
+        }
+        self.incidence_offsets = offsets;
+        self.incidence = list;
+        for i in 0..n {
+            self.update_shares(i);
+        }
+        self
+    }
+
+    /// Recompute the correction shares around `node` after its inverse mass changed.
+    fn update_shares(&mut self, node: usize) {
+        let (a, b) = (
+            self.incidence_offsets[node] as usize,
+            self.incidence_offsets[node + 1] as usize,
+        );
+        for k in a..b {
+            let other = self.incidence[k].other as usize;
+            let (wi, wo) = (self.inv_mass[node], self.inv_mass[other]);
+            self.incidence[k].share = if wi + wo > 0.0 { wi / (wi + wo) } else { 0.0 };
+            // The other node's view of the same edge.
+            let (oa, ob) = (
+                self.incidence_offsets[other] as usize,
+                self.incidence_offsets[other + 1] as usize,
+            );
+            for m in oa..ob {
+                if self.incidence[m].other as usize == node {
+                    self.incidence[m].share = if wi + wo > 0.0 { wo / (wi + wo) } else { 0.0 };
+                }
+            }
+        }
+    }
+
+    /// The edges around `node`, with their other node, sign and correction share.
+    #[inline]
+    pub fn incidence(&self, node: usize) -> &[Incidence] {
+        &self.incidence
+            [self.incidence_offsets[node] as usize..self.incidence_offsets[node + 1] as usize]
     }
 
     /// The topology.

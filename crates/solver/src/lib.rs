@@ -10,16 +10,16 @@
 //! - [`ClothState`]: positions, velocities, warm-start forces, hysteresis states;
 //! - [`Solver::step`]: one step, with [`StepParams`] and a [`StepReport`] of diagnostics.
 
-pub mod cloth;
 pub mod baselines;
+pub mod cloth;
 pub mod metrics;
-pub mod scenes;
 pub mod params;
+pub mod scenes;
 pub mod shear;
 pub mod state;
 pub mod step;
 
-pub use cloth::{Cloth, ClothError, ClothOptions, Pin, PinMotion};
+pub use cloth::{Cloth, ClothError, ClothOptions, Incidence, Pin, PinMotion};
 pub use params::{
     ConstraintKind, InternalMethod, ParamError, ShapeMethod, StepParams, TolerancePolicy,
 };

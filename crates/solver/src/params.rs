@@ -92,7 +92,8 @@ pub struct StepParams {
     /// times its value with all forces zero (the thesis stops on E's relative change, which
     /// stalls when E cannot reach zero; see `docs/solver.md`). Range (0, 1); default 1e-4.
     pub internal_tolerance: f64,
-    /// Iteration cap for the internal forces. Range ≥ 1; default 200.
+    /// Iteration cap for the internal forces, per phase. Range ≥ 1; default 30 (the forces are
+    /// warm-started, so a moving cloth converges over steps).
     pub internal_max_iterations: usize,
     /// Shape-constraint method. Default `Chebyshev { rho: 0.99 }`.
     pub shape_method: ShapeMethod,
@@ -102,7 +103,8 @@ pub struct StepParams {
     /// ε^e: stop the shape iterations when the RMS of R (the per-node length error) is below it,
     /// m. Range > 0; default 1e-6.
     pub shape_tolerance: f64,
-    /// Iteration cap for the shape constraints per collision pass. Range ≥ 1; default 60.
+    /// Iteration cap for the shape constraints per collision pass. Range ≥ 1; default 30 (the
+    /// thesis: about 30 per pass, two passes).
     pub shape_max_iterations: usize,
     /// Collision passes per step; the shape iterations are split between them (the thesis: two
     /// passes of ~30 iterations). Range ≥ 1; default 2.
@@ -123,6 +125,10 @@ pub struct StepParams {
     /// 0.25 s). Their tangent is capped at this multiple of B over a tiny band
     /// (`Spindle::with_stick_slope`). Range > 1 (∞ = exact); default 4.
     pub bending_stick_slope: f64,
+    /// Reversal dead band of the bending hysteresis, as a fraction of each characteristic's
+    /// M₀/B (`Spindle::with_deadband`): curvature jitter smaller than this does not start a
+    /// minor loop. Range [0, 1); default 0.05.
+    pub bending_deadband: f64,
     /// Skip bending entirely (an inextensible chain or membrane). Default false.
     pub bending_off: bool,
     /// Divergence guard: a step whose result stretches or shrinks any edge by more than this
@@ -143,17 +149,18 @@ impl Default for StepParams {
             internal_method: InternalMethod::Accelerated,
             internal_step: 1.0,
             internal_tolerance: 1e-4,
-            internal_max_iterations: 200,
+            internal_max_iterations: 30,
             shape_method: ShapeMethod::Chebyshev { rho: 0.99 },
             shape_step: 1.0,
             shape_tolerance: 1e-6,
-            shape_max_iterations: 60,
+            shape_max_iterations: 30,
             collision_passes: 2,
             axial_constraint: ConstraintKind::Equality,
             diagonal_constraint: ConstraintKind::Equality,
             tolerance_policy: TolerancePolicy::Fixed,
             implicit_bending: true,
             bending_stick_slope: 4.0,
+            bending_deadband: 0.05,
             bending_off: false,
             divergence_strain: 1.0,
             hysteresis: true,

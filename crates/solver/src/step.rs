@@ -65,7 +65,9 @@ pub enum StepError {
         found: usize,
     },
     /// The step would stretch an edge beyond `StepParams::divergence_strain`.
-    #[error("diverging: edge {edge} would reach strain {strain:.3} (limit {limit}) at time {time} s; Δt too large or tolerances too loose")]
+    #[error(
+        "diverging: edge {edge} would reach strain {strain:.3} (limit {limit}) at time {time} s; Δt too large or tolerances too loose"
+    )]
     Diverged {
         /// The edge.
         edge: usize,
@@ -189,6 +191,10 @@ struct Scratch {
     w_p: Vec<f64>,
     w_ap: Vec<f64>,
     w_dm: Vec<f64>,
+    w_rhat: Vec<f64>,
+    w_v: Vec<f64>,
+    w_y: Vec<f64>,
+    w_t: Vec<f64>,
     f_sum: Vec<V3>,
     f_m: Vec<V3>,
     p: Vec<f64>,
@@ -255,6 +261,13 @@ fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync + Send) {
     } else {
         out.iter_mut().enumerate().for_each(|(i, o)| *o = f(i));
     }
+}
+
+/// A bending characteristic with the step's regularisation: stick slope and reversal dead band
+/// (a fraction of M₀/B).
+fn regularised(s: &atelier_fabric::Spindle, stick: f64, band: f64) -> atelier_fabric::Spindle {
+    s.with_stick_slope(stick)
+        .with_deadband(band * s.residual_moment() / s.rigidity())
 }
 
 fn first_non_finite_v(v: &[V3]) -> Option<usize> {
@@ -452,7 +465,14 @@ impl Solver {
             let worst = edges
                 .iter()
                 .enumerate()
-                .map(|(e, edge)| (e, ((pred[edge.b as usize] - pred[edge.a as usize]).norm() / edge.rest_length - 1.0).abs()))
+                .map(|(e, edge)| {
+                    (
+                        e,
+                        ((pred[edge.b as usize] - pred[edge.a as usize]).norm() / edge.rest_length
+                            - 1.0)
+                            .abs(),
+                    )
+                })
                 .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
             if worst.1 > params.divergence_strain {
                 return Err(StepError::Diverged {
@@ -497,7 +517,15 @@ impl Solver {
             resize(v, n, z);
         }
         resize(&mut s.eta, n, [0.0; SLOTS]);
-        for v in [&mut s.node_moment, &mut s.w, &mut s.w_r, &mut s.w_z, &mut s.w_p, &mut s.w_ap, &mut s.w_dm] {
+        for v in [
+            &mut s.node_moment,
+            &mut s.w,
+            &mut s.w_r,
+            &mut s.w_z,
+            &mut s.w_p,
+            &mut s.w_ap,
+            &mut s.w_dm,
+        ] {
             resize(v, n, 0.0);
         }
         resize(&mut s.slot_coef, n, [0.0; SLOTS]);
@@ -556,12 +584,20 @@ impl Solver {
         // are all pinned), so a clamp imposes its tangent plane on the bending at its edge;
         // with the free triangles mixed in, the clamp would act half as stiff and the
         // cantilever converge at first order only (docs/solver.md).
-        let clamped = |t: u32| tris[t as usize].iter().all(|&k| cloth.is_pinned(k as usize));
+        let clamped = |t: u32| {
+            tris[t as usize]
+                .iter()
+                .all(|&k| cloth.is_pinned(k as usize))
+        };
         fill(&mut s.normal, |i| {
             let incident = topo.incident_triangles(i);
             let mut sum: V3 = V3::zeros();
             if cloth.is_pinned(i) {
-                sum = incident.iter().filter(|&&t| clamped(t)).map(|&t| tn[t as usize]).sum();
+                sum = incident
+                    .iter()
+                    .filter(|&&t| clamped(t))
+                    .map(|&t| tn[t as usize])
+                    .sum();
             }
             if sum == V3::zeros() {
                 sum = incident.iter().map(|&t| tn[t as usize]).sum();
@@ -585,7 +621,7 @@ impl Solver {
         );
         let pos = &state.positions;
         let hysteresis = params.hysteresis && cloth.bending_hysteretic();
-        let stick = params.bending_stick_slope;
+        let (stick, band) = (params.bending_stick_slope, params.bending_deadband);
         let s = &mut self.s;
         let normal = &s.normal;
         fill(&mut s.eta, |i| {
@@ -609,7 +645,7 @@ impl Solver {
                     continue;
                 }
                 for k in [k0, k1] {
-                    let spindle = table.bending(mats[i][k]).with_stick_slope(stick);
+                    let spindle = regularised(table.bending(mats[i][k]), stick, band);
                     let l = (pos[axial[i][k] as usize] - pos[i]).norm();
                     let per_width = if hysteresis {
                         bending_states[i][k].moment(&spindle, eta[i][k])
@@ -678,20 +714,16 @@ impl Solver {
     /// The same from p (`from_y` false) or from the extrapolated point y of the accelerated
     /// method (`from_y` true).
     fn gather_from(&mut self, cloth: &Cloth, diagonals: bool, from_y: bool) {
-        let topo = cloth.topology();
-        let edges = topo.edges();
         let s = &mut self.s;
         let p: &[f64] = if from_y { &s.p_y } else { &s.p };
         let (dir, f_sum) = (&s.dir, &s.f_sum);
         fill(&mut s.f_m, |i| {
             let mut f = f_sum[i];
-            for &e in topo.incident_edges(i) {
-                let edge = &edges[e as usize];
-                if !diagonals && !edge.kind.is_axial() {
-                    continue;
+            for inc in cloth.incidence(i) {
+                if diagonals || inc.axial {
+                    let e = inc.edge as usize;
+                    f += dir[e] * (inc.sign * p[e]);
                 }
-                let sign = if edge.a as usize == i { 1.0 } else { -1.0 };
-                f += dir[e as usize] * (sign * p[e as usize]);
             }
             f
         });
@@ -779,7 +811,13 @@ impl Solver {
 
     /// One phase of the internal-force solve (thesis (45)–(47)): projected steepest descent, or
     /// the accelerated variant; only this phase's p change. Returns the iterations used.
-    fn internal_phase(&mut self, cloth: &Cloth, params: &StepParams, diagonals: bool, factor: f64) -> usize {
+    fn internal_phase(
+        &mut self,
+        cloth: &Cloth,
+        params: &StepParams,
+        diagonals: bool,
+        factor: f64,
+    ) -> usize {
         let edges = cloth.topology().edges();
         let lambda = self.lambda.map_or(1.0, |l| l[usize::from(diagonals)]);
         let mut gamma = params.internal_step / lambda;
@@ -850,7 +888,11 @@ impl Solver {
                     {
                         let (p, prev, y) = (&self.s.p, &self.s.p_prev, &mut self.s.p_y);
                         for e in 0..y.len() {
-                            y[e] = if in_phase(e) { (p[e] + beta * (p[e] - prev[e])).max(0.0) } else { p[e] };
+                            y[e] = if in_phase(e) {
+                                (p[e] + beta * (p[e] - prev[e])).max(0.0)
+                            } else {
+                                p[e]
+                            };
                         }
                     }
                     self.gather_from(cloth, diagonals, true);
@@ -862,7 +904,8 @@ impl Solver {
                     iterations += 1;
                     let mut restart = 0.0;
                     {
-                        let (p, prev, y, grad) = (&mut self.s.p, &mut self.s.p_prev, &self.s.p_y, &self.s.grad);
+                        let (p, prev, y, grad) =
+                            (&mut self.s.p, &mut self.s.p_prev, &self.s.p_y, &self.s.grad);
                         for e in 0..p.len() {
                             if in_phase(e) {
                                 let new = (y[e] - gamma * grad[e]).max(0.0);
@@ -933,7 +976,11 @@ impl Solver {
         // free nodes; (μ + cΔt) w − Δt² K w = (μ + cΔt) n·ṙ_explicit, K the bending stiffness
         // for normal displacements (the same stencil as the force, with B), solved by
         // Jacobi-preconditioned CG. Statics are unchanged; rigid motions have K w = 0.
-        let k_apply = |w: &[f64], dm: &mut [f64], out: &mut [f64], s_coef: &[[f64; SLOTS]], s_len: &[[f64; SLOTS]]| {
+        let k_apply = |w: &[f64],
+                       dm: &mut [f64],
+                       out: &mut [f64],
+                       s_coef: &[[f64; SLOTS]],
+                       s_len: &[[f64; SLOTS]]| {
             fill(dm, |i| {
                 let mut m = 0.0;
                 for k in 0..SLOTS {
@@ -942,7 +989,8 @@ impl Solver {
                         continue;
                     }
                     let l = s_len[i][k];
-                    let deta = -2.0 * (w[a as usize] * normal[i].dot(&normal[a as usize]) - w[i]) / (l * l);
+                    let deta = -2.0 * (w[a as usize] * normal[i].dot(&normal[a as usize]) - w[i])
+                        / (l * l);
                     m += s_coef[i][k] * deta;
                 }
                 m
@@ -989,24 +1037,38 @@ impl Solver {
         let n = s.w.len();
         let r0: f64 = s.w_r.iter().map(|x| x * x).sum::<f64>().sqrt();
         if r0 > 0.0 {
-            let apply_a = |x: &[f64], dm: &mut [f64], out: &mut [f64], s_coef: &[[f64; SLOTS]], s_len: &[[f64; SLOTS]]| {
+            let apply_a = |x: &[f64],
+                           dm: &mut [f64],
+                           out: &mut [f64],
+                           s_coef: &[[f64; SLOTS]],
+                           s_len: &[[f64; SLOTS]]| {
                 k_apply(x, dm, out, s_coef, s_len);
                 for i in 0..x.len() {
                     let (mu, c) = (mass[i], params.damping * areas[i]);
-                    out[i] = if free(i) { (mu + c * dt) * x[i] - dt * dt * out[i] } else { 0.0 };
+                    out[i] = if free(i) {
+                        (mu + c * dt) * x[i] - dt * dt * out[i]
+                    } else {
+                        0.0
+                    };
                 }
             };
             let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-            let r_hat = s.w_r.clone();
+            let mut r_hat = std::mem::take(&mut s.w_rhat);
+            r_hat.clear();
+            r_hat.extend_from_slice(&s.w_r);
+            let mut v = std::mem::take(&mut s.w_v);
+            let mut y = std::mem::take(&mut s.w_y);
+            let mut z = std::mem::take(&mut s.w_z);
+            let mut t = std::mem::take(&mut s.w_t);
+            for buf in [&mut v, &mut y, &mut z, &mut t] {
+                buf.clear();
+                buf.resize(n, 0.0);
+            }
             let mut rho = 1.0;
             let mut alpha = 1.0;
             let mut omega = 1.0;
             s.w_p.iter_mut().for_each(|x| *x = 0.0);
-            let mut v = vec![0.0; n];
-            let mut y = vec![0.0; n];
-            let mut z = vec![0.0; n];
-            let mut t = vec![0.0; n];
-            for _ in 0..40 {
+            for _ in 0..10 {
                 let rho_new = dot(&r_hat, &s.w_r);
                 if rho_new == 0.0 || omega == 0.0 {
                     break;
@@ -1027,7 +1089,7 @@ impl Solver {
                     s.w[i] += alpha * y[i];
                     s.w_r[i] -= alpha * v[i];
                 }
-                if dot(&s.w_r, &s.w_r).sqrt() <= 1e-10 * r0 {
+                if dot(&s.w_r, &s.w_r).sqrt() <= 1e-4 * r0 {
                     break;
                 }
                 for i in 0..n {
@@ -1040,10 +1102,15 @@ impl Solver {
                     s.w[i] += omega * z[i];
                     s.w_r[i] -= omega * t[i];
                 }
-                if dot(&s.w_r, &s.w_r).sqrt() <= 1e-10 * r0 {
+                if dot(&s.w_r, &s.w_r).sqrt() <= 1e-4 * r0 {
                     break;
                 }
             }
+            s.w_rhat = r_hat;
+            s.w_v = v;
+            s.w_y = y;
+            s.w_z = z;
+            s.w_t = t;
         }
         let w = &s.w;
         for (i, v) in s.vel.iter_mut().enumerate() {
@@ -1148,47 +1215,51 @@ impl Solver {
             let (pos, vel) = (&state.positions, &s.vel);
             fill(&mut s.pred, |i| pos[i] + vel[i] * dt);
             let (pred, target) = (&s.pred, &s.target);
-            fill(&mut s.cdir, |e| {
-                let d = pred[edges[e].b as usize] - pred[edges[e].a as usize];
-                let l = d.norm();
-                if l > 0.0 { d / l } else { V3::zeros() }
-            });
-            fill(&mut s.c, |e| {
+            let (axial_kind, diagonal_kind) = (params.axial_constraint, params.diagonal_constraint);
+            let edge_error = |(e, (dir, c)): (usize, (&mut V3, &mut f64))| {
                 let edge = &edges[e];
-                let l = (pred[edge.b as usize] - pred[edge.a as usize]).norm();
-                let c = l - target[e];
+                let d = pred[edge.b as usize] - pred[edge.a as usize];
+                let l = d.norm();
+                *dir = if l > 0.0 { d / l } else { V3::zeros() };
                 let kind = if edge.kind.is_axial() {
-                    params.axial_constraint
+                    axial_kind
                 } else {
-                    params.diagonal_constraint
+                    diagonal_kind
                 };
-                match kind {
-                    ConstraintKind::Equality => c,
-                    ConstraintKind::StretchOnly => c.max(0.0),
-                }
-            });
+                *c = match kind {
+                    ConstraintKind::Equality => l - target[e],
+                    ConstraintKind::StretchOnly => (l - target[e]).max(0.0),
+                };
+            };
+            if edges.len() >= PAR_MIN {
+                s.cdir
+                    .par_iter_mut()
+                    .zip(s.c.par_iter_mut())
+                    .enumerate()
+                    .for_each(edge_error);
+            } else {
+                s.cdir
+                    .iter_mut()
+                    .zip(s.c.iter_mut())
+                    .enumerate()
+                    .for_each(edge_error);
+            }
             let (c, cdir) = (&s.c, &s.cdir);
             fill(&mut s.r, |i| {
-                if inv[i] == 0.0 {
-                    return V3::zeros();
-                }
                 let mut r = V3::zeros();
-                for &e in topo.incident_edges(i) {
-                    let edge = &edges[e as usize];
-                    let (other, sign) = if edge.a as usize == i {
-                        (edge.b, 1.0)
-                    } else {
-                        (edge.a, -1.0)
-                    };
-                    let w = inv[i] / (inv[i] + inv[other as usize]);
-                    r += cdir[e as usize] * (sign * w * c[e as usize]);
+                for inc in cloth.incidence(i) {
+                    let e = inc.edge as usize;
+                    r += cdir[e] * (inc.sign * inc.share * c[e]);
                 }
                 r
             });
             let r = &s.r;
-            residual = (det_sum(&mut s.chunk, r.len(), |i| r[i].norm_squared()) / free).sqrt();
-            if residual < tol {
-                break;
+            // The residual (a full reduction) is checked every fourth iteration and at the cap.
+            if k % 4 == 0 || k + 1 == params.shape_max_iterations {
+                residual = (det_sum(&mut s.chunk, r.len(), |i| r[i].norm_squared()) / free).sqrt();
+                if residual < tol {
+                    break;
+                }
             }
             iterations += 1;
             // Jacobi averaging: a node moves by γ times the mean of its constraints' corrections.
@@ -1198,7 +1269,7 @@ impl Solver {
             ) {
                 let (vel, gamma) = (&s.vel, params.shape_step);
                 fill(&mut s.vel_hat, |i| {
-                    let count = topo.incident_edges(i).len() as f64;
+                    let count = cloth.incidence(i).len() as f64;
                     vel[i] + r[i] * (gamma / (count * dt))
                 });
             }
@@ -1408,7 +1479,12 @@ impl Solver {
             for (i, slots) in state.bending.iter_mut().enumerate() {
                 for (k, st) in slots.iter_mut().enumerate() {
                     if axial[i][k] != NO_NODE {
-                        st.update(&table.bending(smats[i][k]).with_stick_slope(params.bending_stick_slope), eta[i][k]);
+                        let spindle = regularised(
+                            table.bending(smats[i][k]),
+                            params.bending_stick_slope,
+                            params.bending_deadband,
+                        );
+                        st.update(&spindle, eta[i][k]);
                     }
                 }
             }

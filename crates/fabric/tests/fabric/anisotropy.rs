@@ -237,3 +237,37 @@ fn every_fixture_interpolates_at_every_angle() {
     }
     assert!(worst < 1e-3, "largest repair {worst}");
 }
+
+/// The plate-theory form is the compliance form for tensile loops and the reciprocal (thesis)
+/// form for bending, and it is valid for every fixture at every half degree, where the thesis
+/// form is not (it turns the cotton's loop inside out near 52.5°).
+#[test]
+fn plate_theory_form_is_valid_at_every_angle() {
+    for name in FIXTURES {
+        let f = fixture(name);
+        let angles: Vec<f64> = (0..360).map(|k| (k as f64 * 0.5).to_radians()).collect();
+        let (table, idx) =
+            MaterialTable::build(&f, AnisotropyForm::PlateTheory, &angles).expect("every angle");
+        assert!(
+            idx.iter().all(|&i| table.repair(i) < 1e-3),
+            "{name}: large repair"
+        );
+        let th = 0.3;
+        same_loop(
+            &f.tensile_at(th, AnisotropyForm::PlateTheory).expect("a"),
+            &f.tensile_at(th, AnisotropyForm::Compliance).expect("b"),
+            1e-12,
+        );
+        let (a, b) = (
+            f.bending_at(th, AnisotropyForm::PlateTheory).expect("a"),
+            f.bending_at(th, AnisotropyForm::Thesis).expect("b"),
+        );
+        assert_relative_eq!(a.rigidity(), b.rigidity(), max_relative = 1e-12);
+    }
+    let cotton = fixture("cotton_broad");
+    assert!(
+        cotton
+            .tensile_at(52.5_f64.to_radians(), AnisotropyForm::Thesis)
+            .is_err()
+    );
+}

@@ -128,7 +128,10 @@ fn spring_stiffness_is_the_secant_of_each_edges_loop() {
         cloth.materials().tensile(cloth.edge_materials()[e]).clone()
     };
     let e_warp_toe = secant_modulus(&material(0.0), 0.01);
-    assert!((e_warp_toe / e_warp - 1.0).abs() < 5e-3, "toe secant {e_warp_toe} vs {e_warp}");
+    assert!(
+        (e_warp_toe / e_warp - 1.0).abs() < 5e-3,
+        "toe secant {e_warp_toe} vs {e_warp}"
+    );
     let e_warp = e_warp_toe;
     let (e_weft, e_bias) = (
         secant_modulus(&material(std::f64::consts::FRAC_PI_2), 0.01),

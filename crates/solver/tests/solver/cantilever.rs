@@ -40,7 +40,11 @@ fn elastica(lambda: f64, n: usize) -> Vec<(f64, f64)> {
     let (mut lo, mut hi) = (0.0, lambda / 2.0);
     for _ in 0..100 {
         let mid = 0.5 * (lo + hi);
-        if shoot(mid, false).0 > 0.0 { hi = mid } else { lo = mid }
+        if shoot(mid, false).0 > 0.0 {
+            hi = mid
+        } else {
+            lo = mid
+        }
     }
     shoot(0.5 * (lo + hi), true).1
 }
@@ -51,8 +55,15 @@ fn elastica(lambda: f64, n: usize) -> Vec<(f64, f64)> {
 fn the_reference_elastica_reproduces_the_published_numbers() {
     let pts = elastica(8.00420, 4000);
     let (x, y) = pts[pts.len() - 1];
-    assert!((y.atan2(x).to_degrees() - 41.5).abs() < 1e-3, "{}", y.atan2(x).to_degrees());
-    assert!((x - 0.7243).abs() < 1e-4 && (y - 0.6408).abs() < 1e-4, "({x}, {y})");
+    assert!(
+        (y.atan2(x).to_degrees() - 41.5).abs() < 1e-3,
+        "{}",
+        y.atan2(x).to_degrees()
+    );
+    assert!(
+        (x - 0.7243).abs() < 1e-4 && (y - 0.6408).abs() < 1e-4,
+        "({x}, {y})"
+    );
     let small = elastica(0.01, 2000);
     assert!((small[small.len() - 1].1 - 0.01 / 8.0).abs() < 1e-6);
 }
@@ -63,13 +74,20 @@ fn the_reference_elastica_reproduces_the_published_numbers() {
 /// x = 0 and −h puts the effective clamp h/2 behind the edge and the angle converges at first
 /// order, 47.6° / 44.9° / 43.5° for 10 / 20 / 40 cells), its tip at x = `length`, run to rest.
 /// Returns the centreline (x, droop) of the free part and the chord angle from the edge.
-fn simulate(name: &str, length: f64, segments: usize, hysteresis: bool, damping: f64) -> (Vec<(f64, f64)>, f64) {
+fn simulate(
+    name: &str,
+    length: f64,
+    segments: usize,
+    hysteresis: bool,
+    damping: f64,
+) -> (Vec<(f64, f64)>, f64) {
     let f = fabric(name);
     let h = length / (segments as f64 + 0.5);
     let width = 0.01;
     let nv = segments + 2;
-    let topo = ClothTopology::from_structured(&StructuredGrid::sheet(2, nv, width, (nv - 1) as f64 * h))
-        .expect("grid");
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(2, nv, width, (nv - 1) as f64 * h))
+            .expect("grid");
     let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
     let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
     for node in 0..4 {
@@ -79,7 +97,12 @@ fn simulate(name: &str, length: f64, segments: usize, hysteresis: bool, damping:
     let mut state = ClothState::placed(&cloth, place);
     // Implicit bending keeps this stable up to about 0.4·h s/m; 0.25·h leaves a margin.
     let dt = 0.25 * h;
-    let params = StepParams { dt, damping, hysteresis, ..StepParams::default() };
+    let params = StepParams {
+        dt,
+        damping,
+        hysteresis,
+        ..StepParams::default()
+    };
     let mut solver = Solver::new();
     let mut t = 0.0;
     loop {
@@ -109,7 +132,10 @@ fn cantilever_droops_to_the_elastica() {
         let f = fabric(name);
         let c = (f.bending.warp.rigidity() / f.weight_per_area()).cbrt();
         let length = 2.0003 * c;
-        let runs: Vec<(Vec<(f64, f64)>, f64)> = [10, 20, 40].iter().map(|&n| simulate(name, length, n, false, 1.0)).collect();
+        let runs: Vec<(Vec<(f64, f64)>, f64)> = [10, 20, 40]
+            .iter()
+            .map(|&n| simulate(name, length, n, false, 1.0))
+            .collect();
         let angles: Vec<f64> = runs.iter().map(|r| r.1).collect();
         let order = ((angles[0] - angles[1]) / (angles[1] - angles[2])).log2();
         let richardson = angles[2] + (angles[2] - angles[1]) / (2f64.powf(order) - 1.0);
@@ -136,8 +162,15 @@ fn cantilever_droops_to_the_elastica() {
             let (ex, ey) = reference[idx];
             worst = worst.max(((x - ex * length).powi(2) + (y - ey * length).powi(2)).sqrt());
         }
-        eprintln!("cantilever {name}: centreline within {:.2} % of the length", 100.0 * worst / length);
-        assert!(worst < 0.02 * length, "{name}: centreline off by {:.2} % of L", 100.0 * worst / length);
+        eprintln!(
+            "cantilever {name}: centreline within {:.2} % of the length",
+            100.0 * worst / length
+        );
+        assert!(
+            worst < 0.02 * length,
+            "{name}: centreline off by {:.2} % of L",
+            100.0 * worst / length
+        );
         // Bending hysteresis, 20 cells, for the report. Released and swinging (light damping),
         // the strip overshoots, turns back onto the falling branch (M lower by 2M₀) and can end
         // more drooped; lowered slowly it stays nearer the initial curve, stiffer than the

@@ -3,7 +3,9 @@
 
 use atelier_fabric::AnisotropyForm;
 use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::{Cloth, ClothState, InternalMethod, PinMotion, Solver, StepError, StepParams, TolerancePolicy};
+use atelier_solver::{
+    Cloth, ClothState, InternalMethod, PinMotion, Solver, StepError, StepParams, TolerancePolicy,
+};
 use nalgebra::Vector3;
 
 use crate::common::fabric;
@@ -13,7 +15,8 @@ use crate::common::fabric;
 fn hang(method: InternalMethod, seconds: f64) -> (Cloth, ClothState, f64, f64) {
     let f = fabric("cotton_broad");
     let n = 41;
-    let topo = ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 1.0, 1.0)).expect("grid");
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 1.0, 1.0)).expect("grid");
     let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
     let place = |[x, y]: [f64; 2]| Vector3::new(x, 0.0, y);
     for i in 0..n {
@@ -22,7 +25,11 @@ fn hang(method: InternalMethod, seconds: f64) -> (Cloth, ClothState, f64, f64) {
         cloth.pin(node as u32, p, PinMotion::Fixed).expect("pin");
     }
     let mut state = ClothState::placed(&cloth, place);
-    let params = StepParams { internal_method: method, damping: 1.0, ..StepParams::default() };
+    let params = StepParams {
+        internal_method: method,
+        damping: 1.0,
+        ..StepParams::default()
+    };
     let mut solver = Solver::new();
     let steps = (seconds / params.dt).round() as usize;
     let (mut iterations, mut counted, mut residual) = (0usize, 0usize, 0.0);
@@ -46,14 +53,28 @@ fn long_hanging_cloth_is_at_its_target_strains_and_rows_stay_level() {
     let mut solver = Solver::new();
     // One more step to read the targets at rest.
     let mut probe = state.clone();
-    let r = solver.step(&cloth, &mut probe, &StepParams { damping: 1.0, ..StepParams::default() }).expect("step");
+    let r = solver
+        .step(
+            &cloth,
+            &mut probe,
+            &StepParams {
+                damping: 1.0,
+                ..StepParams::default()
+            },
+        )
+        .expect("step");
     assert!(r.max_speed < 1e-3, "not at rest: {} m/s", r.max_speed);
-    assert!(r.max_strain_error < 5e-3, "max |ε − ε̄| = {}", r.max_strain_error);
+    assert!(
+        r.max_strain_error < 5e-3,
+        "max |ε − ε̄| = {}",
+        r.max_strain_error
+    );
     let n = 41;
     let mut worst_row: f64 = 0.0;
     for j in 0..n {
         let z: Vec<f64> = (0..n).map(|i| probe.positions[j * n + i].z).collect();
-        let spread = z.iter().cloned().fold(f64::MIN, f64::max) - z.iter().cloned().fold(f64::MAX, f64::min);
+        let spread =
+            z.iter().cloned().fold(f64::MIN, f64::max) - z.iter().cloned().fold(f64::MAX, f64::min);
         worst_row = worst_row.max(spread);
     }
     eprintln!(
@@ -61,7 +82,10 @@ fn long_hanging_cloth_is_at_its_target_strains_and_rows_stay_level() {
         r.max_strain_error, worst_row
     );
     assert!(worst_row < 1e-3, "rows sag by {worst_row} m");
-    assert!(residual < 1e-3, "internal forces do not carry the weight: E/E₀ = {residual}");
+    assert!(
+        residual < 1e-3,
+        "internal forces do not carry the weight: E/E₀ = {residual}"
+    );
 }
 
 /// The accelerated internal-force method reaches the same balance with fewer iterations than
@@ -70,7 +94,9 @@ fn long_hanging_cloth_is_at_its_target_strains_and_rows_stay_level() {
 fn accelerated_internal_forces_need_fewer_iterations_than_steepest_descent() {
     let (_, _, fast, fast_res) = hang(InternalMethod::Accelerated, 2.0);
     let (_, _, slow, slow_res) = hang(InternalMethod::SteepestDescent, 2.0);
-    eprintln!("hanging sheet, last second: accelerated {fast:.1} iterations/step (E/E₀ {fast_res:.1e}), steepest descent {slow:.1} (E/E₀ {slow_res:.1e})");
+    eprintln!(
+        "hanging sheet, last second: accelerated {fast:.1} iterations/step (E/E₀ {fast_res:.1e}), steepest descent {slow:.1} (E/E₀ {slow_res:.1e})"
+    );
     assert!(fast < slow, "accelerated {fast} vs steepest {slow}");
 }
 
@@ -81,16 +107,30 @@ fn accelerated_internal_forces_need_fewer_iterations_than_steepest_descent() {
 fn stress_never_produces_non_finite_state() {
     for name in ["denim", "silk"] {
         let f = fabric(name);
-        let emt = f.tensile.warp.apex_strain().max(f.tensile.weft.apex_strain());
+        let emt = f
+            .tensile
+            .warp
+            .apex_strain()
+            .max(f.tensile.weft.apex_strain());
         for dt in [0.01, 0.02, 0.05] {
             let n = 21;
-            let topo = ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 0.5, 0.5)).expect("grid");
+            let topo = ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 0.5, 0.5))
+                .expect("grid");
             let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
             let place = |[x, y]: [f64; 2]| Vector3::new(x, 0.0, y);
             for i in 0..n {
                 let node = (n - 1) * n + i;
                 let p = place(cloth.topology().rest_positions()[node]);
-                cloth.pin(node as u32, p, PinMotion::Oscillate { amplitude: [0.0, 0.3, 0.0], frequency: 5.0 / (2.0 * std::f64::consts::PI * 0.3) }).expect("pin");
+                cloth
+                    .pin(
+                        node as u32,
+                        p,
+                        PinMotion::Oscillate {
+                            amplitude: [0.0, 0.3, 0.0],
+                            frequency: 5.0 / (2.0 * std::f64::consts::PI * 0.3),
+                        },
+                    )
+                    .expect("pin");
             }
             let mut state = ClothState::placed(&cloth, place);
             let params = StepParams {
@@ -100,7 +140,11 @@ fn stress_never_produces_non_finite_state() {
                 shape_tolerance: 1e-3,
                 shape_max_iterations: 5,
                 collision_passes: 1,
-                tolerance_policy: TolerancePolicy::Adaptive { loose_factor: 1.5, fast_speed: 1.0, slow_speed: 0.1 },
+                tolerance_policy: TolerancePolicy::Adaptive {
+                    loose_factor: 1.5,
+                    fast_speed: 1.0,
+                    slow_speed: 0.1,
+                },
                 ..StepParams::default()
             };
             let mut solver = Solver::new();
@@ -110,19 +154,34 @@ fn stress_never_produces_non_finite_state() {
                 let before = state.clone();
                 match solver.step(&cloth, &mut state, &params) {
                     Ok(_) => {
-                        assert!(state.positions.iter().all(|p| p.iter().all(|x| x.is_finite())));
-                        worst = worst.max(state.strains(&cloth).iter().cloned().fold(0.0, f64::max));
+                        assert!(
+                            state
+                                .positions
+                                .iter()
+                                .all(|p| p.iter().all(|x| x.is_finite()))
+                        );
+                        worst =
+                            worst.max(state.strains(&cloth).iter().cloned().fold(0.0, f64::max));
                     }
                     Err(e) => {
-                        assert!(matches!(e, StepError::NonFinite { .. } | StepError::Diverged { .. }), "{e}");
+                        assert!(
+                            matches!(e, StepError::NonFinite { .. } | StepError::Diverged { .. }),
+                            "{e}"
+                        );
                         assert_eq!(state, before, "a failed step must keep the state");
                         outcome = "error";
                         break;
                     }
                 }
             }
-            eprintln!("stress {name} Δt {dt}: {outcome}, max strain {worst:.3} (3·EMT = {:.3})", 3.0 * emt);
-            assert!(outcome == "error" || worst < 3.0 * emt, "{name} Δt {dt}: strain {worst} unbounded");
+            eprintln!(
+                "stress {name} Δt {dt}: {outcome}, max strain {worst:.3} (3·EMT = {:.3})",
+                3.0 * emt
+            );
+            assert!(
+                outcome == "error" || worst < 3.0 * emt,
+                "{name} Δt {dt}: strain {worst} unbounded"
+            );
         }
     }
 }
@@ -151,23 +210,46 @@ enum Outcome {
 fn stress_run(name: &str, which: Which, dt: f64) -> Outcome {
     use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
     let f = fabric(name);
-    let emt = f.tensile.warp.apex_strain().max(f.tensile.weft.apex_strain());
+    let emt = f
+        .tensile
+        .warp
+        .apex_strain()
+        .max(f.tensile.weft.apex_strain());
     let n = 21;
-    let topo = ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 0.5, 0.5)).expect("grid");
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 0.5, 0.5)).expect("grid");
     let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
     let place = |[x, y]: [f64; 2]| Vector3::new(x, 0.0, y);
     let frequency = 5.0 / (2.0 * std::f64::consts::PI * 0.3);
     for i in 0..n {
         let node = (n - 1) * n + i;
         let p = place(cloth.topology().rest_positions()[node]);
-        cloth.pin(node as u32, p, PinMotion::Oscillate { amplitude: [0.0, 0.3, 0.0], frequency }).expect("pin");
+        cloth
+            .pin(
+                node as u32,
+                p,
+                PinMotion::Oscillate {
+                    amplitude: [0.0, 0.3, 0.0],
+                    frequency,
+                },
+            )
+            .expect("pin");
     }
     let mut state = ClothState::placed(&cloth, place);
     let steps = (0.5 / dt).round() as usize;
     let (mut party, mut ms, mut xp) = (Solver::new(), MassSpring::new(), Xpbd::new());
-    let party_params = StepParams { dt, ..StepParams::default() };
-    let ms_params = MassSpringParams { dt, ..MassSpringParams::default() };
-    let xp_params = XpbdParams { dt, ..XpbdParams::default() };
+    let party_params = StepParams {
+        dt,
+        ..StepParams::default()
+    };
+    let ms_params = MassSpringParams {
+        dt,
+        ..MassSpringParams::default()
+    };
+    let xp_params = XpbdParams {
+        dt,
+        ..XpbdParams::default()
+    };
     let mut outcome = Outcome::Bounded;
     for _ in 0..steps {
         let ok = match which {
@@ -178,7 +260,12 @@ fn stress_run(name: &str, which: Which, dt: f64) -> Outcome {
         if !ok {
             return Outcome::Error;
         }
-        assert!(state.positions.iter().all(|p| p.iter().all(|x| x.is_finite())));
+        assert!(
+            state
+                .positions
+                .iter()
+                .all(|p| p.iter().all(|x| x.is_finite()))
+        );
         if state.strains(&cloth).iter().any(|s| s.abs() > 3.0 * emt) {
             outcome = Outcome::LargeStrain;
         }
@@ -196,10 +283,23 @@ fn largest_stable_time_step_per_solver() {
     let ladder = [5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2, 5e-2];
     for name in ["denim", "silk"] {
         for which in [Which::Party, Which::MassSpring, Which::Xpbd] {
-            let outcomes: Vec<(f64, Outcome)> = ladder.iter().map(|&dt| (dt, stress_run(name, which, dt))).collect();
-            let bounded = outcomes.iter().rev().find(|o| o.1 == Outcome::Bounded).map(|o| o.0);
-            let no_error = outcomes.iter().rev().find(|o| o.1 != Outcome::Error).map(|o| o.0);
-            eprintln!("stability {name} {which:?}: largest bounded Δt {bounded:?}, largest without error {no_error:?}; {outcomes:?}");
+            let outcomes: Vec<(f64, Outcome)> = ladder
+                .iter()
+                .map(|&dt| (dt, stress_run(name, which, dt)))
+                .collect();
+            let bounded = outcomes
+                .iter()
+                .rev()
+                .find(|o| o.1 == Outcome::Bounded)
+                .map(|o| o.0);
+            let no_error = outcomes
+                .iter()
+                .rev()
+                .find(|o| o.1 != Outcome::Error)
+                .map(|o| o.0);
+            eprintln!(
+                "stability {name} {which:?}: largest bounded Δt {bounded:?}, largest without error {no_error:?}; {outcomes:?}"
+            );
             if matches!(which, Which::Party) {
                 assert!(bounded.is_some(), "{name}: PARTY unbounded at every Δt");
             }

@@ -14,7 +14,8 @@ use crate::common::fabric;
 #[test]
 fn free_fall_with_linear_drag_converges_at_first_order() {
     let f = fabric("cotton_broad");
-    let topo = ClothTopology::from_structured(&StructuredGrid::sheet(6, 5, 0.5, 0.4)).expect("grid");
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(6, 5, 0.5, 0.4)).expect("grid");
     let cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
     let damping = 0.5; // kg/(m²·s)
     let g = atelier_fabric::STANDARD_GRAVITY;
@@ -25,24 +26,41 @@ fn free_fall_with_linear_drag_converges_at_first_order() {
     let mut errors = Vec::new();
     for dt in [0.01, 0.005, 0.0025] {
         let mut state = ClothState::flat(&cloth, 0.0);
-        let params = StepParams { dt, damping, ..StepParams::default() };
+        let params = StepParams {
+            dt,
+            damping,
+            ..StepParams::default()
+        };
         let mut solver = Solver::new();
         for _ in 0..(t_end / dt).round() as usize {
             solver.step(&cloth, &mut state, &params).expect("step");
         }
         // Rigid fall: every node has the same velocity and drop; no edge stretched.
         for (p, v) in state.positions.iter().zip(&state.velocities) {
-            assert!((v - state.velocities[0]).norm() < 1e-9 * exact_v, "{v:?} vs {:?}", state.velocities[0]);
+            assert!(
+                (v - state.velocities[0]).norm() < 1e-9 * exact_v,
+                "{v:?} vs {:?}",
+                state.velocities[0]
+            );
             assert!((p - state.positions[0]).z.abs() < 1e-9);
         }
         let (v, z) = (-state.velocities[0].z, state.positions[0].z);
-        errors.push(((v - exact_v).abs() / exact_v, (z - exact_z).abs() / exact_z.abs()));
+        errors.push((
+            (v - exact_v).abs() / exact_v,
+            (z - exact_z).abs() / exact_z.abs(),
+        ));
     }
     for w in errors.windows(2) {
         let order_v = (w[0].0 / w[1].0).log2();
         let order_z = (w[0].1 / w[1].1).log2();
-        assert!((order_v - 1.0).abs() < 0.1, "velocity order {order_v} ({errors:?})");
-        assert!((order_z - 1.0).abs() < 0.1, "position order {order_z} ({errors:?})");
+        assert!(
+            (order_v - 1.0).abs() < 0.1,
+            "velocity order {order_v} ({errors:?})"
+        );
+        assert!(
+            (order_z - 1.0).abs() < 0.1,
+            "position order {order_z} ({errors:?})"
+        );
     }
     // At Δt = 0.0025 s both are within 0.2 % of the closed form.
     assert!(errors[2].0 < 2e-3 && errors[2].1 < 2e-3, "{errors:?}");
@@ -53,7 +71,11 @@ fn catenary_parameter(d: f64, l: f64) -> f64 {
     let (mut lo, mut hi) = (1e-4, 1e4);
     for _ in 0..200 {
         let a = (lo * hi as f64).sqrt();
-        if 2.0 * a * (d / (2.0 * a)).sinh() > l { lo = a } else { hi = a }
+        if 2.0 * a * (d / (2.0 * a)).sinh() > l {
+            lo = a
+        } else {
+            hi = a
+        }
     }
     (lo * hi).sqrt()
 }
@@ -65,14 +87,20 @@ fn catenary_parameter(d: f64, l: f64) -> f64 {
 fn hanging_strip_matches_the_catenary() {
     let f = fabric("cotton_broad");
     let (length, span, segments) = (1.0, 0.8, 50);
-    let topo = ClothTopology::from_structured(&StructuredGrid::sheet(segments + 1, 2, length, 0.01)).expect("grid");
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(segments + 1, 2, length, 0.01))
+            .expect("grid");
     let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
     // Start on a circular arc of the strip's length through both supports (no initial stretch).
     let a = catenary_parameter(span, length);
     let (mut lo, mut hi) = (1e-6_f64, std::f64::consts::PI - 1e-9); // half-angle of the arc
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
-        if span / (2.0 * mid.sin()) * 2.0 * mid > length { hi = mid } else { lo = mid }
+        if span / (2.0 * mid.sin()) * 2.0 * mid > length {
+            hi = mid
+        } else {
+            lo = mid
+        }
     }
     let half = 0.5 * (lo + hi);
     let radius = span / (2.0 * half.sin());
@@ -89,20 +117,33 @@ fn hanging_strip_matches_the_catenary() {
         }
     }
     let mut state = ClothState::placed(&cloth, place);
-    let params = StepParams { dt: 0.005, damping: 2.0, bending_off: true, ..StepParams::default() };
+    let params = StepParams {
+        dt: 0.005,
+        damping: 2.0,
+        bending_off: true,
+        ..StepParams::default()
+    };
     let mut solver = Solver::new();
     let mut report = None;
     for _ in 0..2000 {
         report = Some(solver.step(&cloth, &mut state, &params).expect("step"));
     }
     let report = report.expect("ran");
-    assert!(report.max_speed < 1e-3, "not at rest: {} m/s", report.max_speed);
+    assert!(
+        report.max_speed < 1e-3,
+        "not at rest: {} m/s",
+        report.max_speed
+    );
     let mut worst: f64 = 0.0;
     for p in &state.positions {
         let exact = a * ((p.x / a).cosh() - (span / (2.0 * a)).cosh());
         worst = worst.max((p.z - exact).abs());
     }
-    assert!(worst < 0.005 * span, "max deviation {worst} m = {:.3} % of the span", 100.0 * worst / span);
+    assert!(
+        worst < 0.005 * span,
+        "max deviation {worst} m = {:.3} % of the span",
+        100.0 * worst / span
+    );
 }
 
 /// The step's results do not depend on the number of threads (deterministic chunked
@@ -111,14 +152,20 @@ fn hanging_strip_matches_the_catenary() {
 fn results_do_not_depend_on_the_thread_count() {
     let f = fabric("polyester_faille");
     let n = 70; // 4 900 nodes: above the parallel threshold
-    let topo = ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 1.0, 1.0)).expect("grid");
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 1.0, 1.0)).expect("grid");
     let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
     let start = ClothState::flat(&cloth, 0.0);
     for node in [(n - 1) * n, n * n - 1] {
-        cloth.pin(node as u32, start.positions[node], PinMotion::Fixed).expect("pin");
+        cloth
+            .pin(node as u32, start.positions[node], PinMotion::Fixed)
+            .expect("pin");
     }
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
         pool.install(|| {
             let mut state = ClothState::flat(&cloth, 0.0);
             let mut solver = Solver::new();
