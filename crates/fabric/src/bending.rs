@@ -532,4 +532,22 @@ mod tests {
         );
         assert_eq!(cotton().with_stick_slope(0.5).stick_slope(), f64::INFINITY);
     }
+
+    #[test]
+    fn deadband_ignores_small_reversals_and_keeps_the_loop() {
+        let s = cotton().with_deadband(1.0);
+        let mut st = BendingState::VIRGIN;
+        // Rising with jitter of 0.5 m⁻¹ (inside the band): no turning point is recorded and
+        // the moment stays on the initial curve / rising branch.
+        for k in 0..200 {
+            let eta = k as f64 + if k % 2 == 0 { 0.0 } else { -0.5 };
+            let m = st.update(&s, eta.max(0.0));
+            assert_relative_eq!(m, s.initial_curve(eta.max(0.0)), max_relative = 1e-9);
+        }
+        assert!(st.turning_point().is_none());
+        // A real reversal (beyond the band) is a turning point at the extreme.
+        st.update(&s, 195.0);
+        assert_eq!(st.turning_point().map(|t| t.0), Some(198.5));
+        assert_eq!(cotton().with_deadband(-1.0).deadband(), 0.0);
+    }
 }
