@@ -95,6 +95,7 @@ fn virtual_kes_tensile_test_recovers_the_loops() {
         let sim = tensile_test(name, &full, 3);
         let model = model_strains(name, &full);
         let mut checked = 0;
+        let mut worst: f64 = 0.0;
         for (k, (&(force, strain), &expect)) in sim.iter().zip(&model).enumerate() {
             let loading = k < 100;
             if force % 50.0 != 0.0 || force == 0.0 && loading {
@@ -118,8 +119,10 @@ fn virtual_kes_tensile_test_recovers_the_loops() {
                 100.0 * err
             );
             checked += 1;
+            worst = worst.max(err);
         }
         assert_eq!(checked, 20, "{name}: ten levels on each branch");
+        eprintln!("KES tensile {name}: largest strain error on the major loop {:.2e} (relative)", worst);
         // Partial cycle to 250 gf/cm: the minor unloading branch of (40).
         let partial = cycle(250.0);
         let sim = tensile_test(name, &partial, 3);
@@ -132,8 +135,10 @@ fn virtual_kes_tensile_test_recovers_the_loops() {
             .map(|(&(f, s), &m)| (f, s, m))
             .collect();
         assert_eq!(minor.len(), 10);
+        let mut worst_minor: f64 = 0.0;
         for (force, strain, expect) in minor {
             let err = (strain - expect).abs() / expect;
+            worst_minor = worst_minor.max(err);
             assert!(
                 err < 0.02,
                 "{name} minor loop at {force} gf/cm: {strain:.5} vs {expect:.5}"
