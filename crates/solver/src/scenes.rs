@@ -65,7 +65,8 @@ pub struct DrapeScene {
     /// How the rim is held.
     pub support: Support,
     /// How the fabric becomes the cloth's materials (anisotropy form, tensile toe). The presets
-    /// use [`ClothOptions::default`] (the thesis's form (33)–(36)).
+    /// use [`ClothOptions::default`]; the thesis's own form (33)–(36) cannot be built on an
+    /// annulus for three of the four Matsudaira fixtures (`docs/validation.md`, "Drape").
     pub cloth_options: ClothOptions,
     /// Amplitude of a seeded, uniformly distributed vertical offset of the free nodes at the
     /// start, m (0: a perfectly flat start). Real drape is multistable and starts from an
@@ -76,8 +77,8 @@ pub struct DrapeScene {
 }
 
 impl DrapeScene {
-    /// JIS L 1096: Ø 25.4 cm specimen on a Ø 12.7 cm support, hinged as in the thesis, thesis
-    /// anisotropy form, flat start.
+    /// JIS L 1096: Ø 25.4 cm specimen on a Ø 12.7 cm support, hinged as in the thesis, default
+    /// cloth options, flat start.
     pub fn jis(n_around: usize, n_rings: usize) -> Self {
         Self {
             specimen_diameter: 0.254,

@@ -122,7 +122,10 @@ fn virtual_kes_tensile_test_recovers_the_loops() {
             worst = worst.max(err);
         }
         assert_eq!(checked, 20, "{name}: ten levels on each branch");
-        eprintln!("KES tensile {name}: largest strain error on the major loop {:.2e} (relative)", worst);
+        eprintln!(
+            "KES tensile {name}: largest strain error on the major loop {:.2e} (relative)",
+            worst
+        );
         // Partial cycle to 250 gf/cm: the minor unloading branch of (40).
         let partial = cycle(250.0);
         let sim = tensile_test(name, &partial, 3);
@@ -170,7 +173,13 @@ fn virtual_kes_bending_test_recovers_b_and_2hb() {
         let (cells, gauge, width) = (10usize, 0.01, 0.01);
         let h = gauge / cells as f64;
         let nv = cells + 3; // one clamp row beyond each end
-        let topo = ClothTopology::from_structured(&StructuredGrid::sheet(2, nv, width, (nv - 1) as f64 * h)).expect("grid");
+        let topo = ClothTopology::from_structured(&StructuredGrid::sheet(
+            2,
+            nv,
+            width,
+            (nv - 1) as f64 * h,
+        ))
+        .expect("grid");
         let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
         let centre = 0.5 * (nv - 1) as f64 * h;
         // Node (i, j) on the arc of curvature k through the centre, tangent along x there.
@@ -186,14 +195,21 @@ fn virtual_kes_bending_test_recovers_b_and_2hb() {
         let rest = cloth.topology().rest_positions().to_vec();
         for &node in &clamped {
             let [x, y] = rest[node];
-            cloth.pin(node as u32, on_arc(0.0, x, y), PinMotion::Fixed).expect("pin");
+            cloth
+                .pin(node as u32, on_arc(0.0, x, y), PinMotion::Fixed)
+                .expect("pin");
         }
         let mut state = ClothState::placed(&cloth, |[x, y]| on_arc(0.0, x, y));
-        let params = StepParams { dt: 1e-3, gravity: [0.0; 3], ..StepParams::default() };
+        let params = StepParams {
+            dt: 1e-3,
+            gravity: [0.0; 3],
+            ..StepParams::default()
+        };
         let mut solver = Solver::new();
         let kmax = units::KES_MAX_CURVATURE;
         let per_leg = 500;
-        let leg = |a: f64, b: f64| (1..=per_leg).map(move |i| a + (b - a) * i as f64 / per_leg as f64);
+        let leg =
+            |a: f64, b: f64| (1..=per_leg).map(move |i| a + (b - a) * i as f64 / per_leg as f64);
         let path: Vec<(usize, f64)> = leg(0.0, kmax)
             .map(|k| (0, k))
             .chain(leg(kmax, -kmax).map(|k| (1, k)))
@@ -204,11 +220,21 @@ fn virtual_kes_bending_test_recovers_b_and_2hb() {
         for (pass, k) in path {
             for &node in &clamped {
                 let [x, y] = rest[node];
-                cloth.pin(node as u32, on_arc(k, x, y), PinMotion::Fixed).expect("pin");
+                cloth
+                    .pin(node as u32, on_arc(k, x, y), PinMotion::Fixed)
+                    .expect("pin");
             }
             solver.step(&cloth, &mut state, &params).expect("step");
-            let eta = middle.iter().map(|&i| 0.5 * (solver.last_curvatures()[i][2] + solver.last_curvatures()[i][3])).sum::<f64>() / 2.0;
-            let moment: f64 = middle.iter().map(|&i| solver.last_node_moments()[i]).sum::<f64>() / width;
+            let eta = middle
+                .iter()
+                .map(|&i| 0.5 * (solver.last_curvatures()[i][2] + solver.last_curvatures()[i][3]))
+                .sum::<f64>()
+                / 2.0;
+            let moment: f64 = middle
+                .iter()
+                .map(|&i| solver.last_node_moments()[i])
+                .sum::<f64>()
+                / width;
             passes[pass].push((eta, moment));
         }
         // The strip's normal may point either way: orient curvature (and moment) so that the
@@ -223,21 +249,33 @@ fn virtual_kes_bending_test_recovers_b_and_2hb() {
             let sel: Vec<(f64, f64)> = pts
                 .iter()
                 .copied()
-                .filter(|p| sign * p.0 >= 0.5 * units::CURVATURE && sign * p.0 <= 1.5 * units::CURVATURE)
+                .filter(|p| {
+                    sign * p.0 >= 0.5 * units::CURVATURE && sign * p.0 <= 1.5 * units::CURVATURE
+                })
                 .collect();
             let n = sel.len() as f64;
             let (sx, sy) = sel.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
             let (mx, my) = (sx / n, sy / n);
-            let (num, den) = sel.iter().fold((0.0, 0.0), |a, p| (a.0 + (p.0 - mx) * (p.1 - my), a.1 + (p.0 - mx).powi(2)));
+            let (num, den) = sel.iter().fold((0.0, 0.0), |a, p| {
+                (a.0 + (p.0 - mx) * (p.1 - my), a.1 + (p.0 - mx).powi(2))
+            });
             num / den
         };
         let at = |pts: &[(f64, f64)], eta: f64| {
-            pts.iter().min_by(|a, b| (a.0 - eta).abs().total_cmp(&(b.0 - eta).abs())).map(|p| p.1).expect("points")
+            pts.iter()
+                .min_by(|a, b| (a.0 - eta).abs().total_cmp(&(b.0 - eta).abs()))
+                .map(|p| p.1)
+                .expect("points")
         };
         let one = units::CURVATURE;
         let b = 0.5 * (slope(&passes[0], 1.0) + slope(&passes[1], -1.0));
-        let two_hb = 0.5 * ((at(&passes[0], one) - at(&passes[1], one)) + (at(&passes[2], -one) - at(&passes[1], -one)));
-        let (b_in, hb_in) = (f.bending.warp.rigidity(), 2.0 * f.bending.warp.residual_moment());
+        let two_hb = 0.5
+            * ((at(&passes[0], one) - at(&passes[1], one))
+                + (at(&passes[2], -one) - at(&passes[1], -one)));
+        let (b_in, hb_in) = (
+            f.bending.warp.rigidity(),
+            2.0 * f.bending.warp.residual_moment(),
+        );
         eprintln!(
             "KES bending {name}: B {:.4} (input {:.4}) gf·cm²/cm, 2HB {:.4} (input {:.4}) gf·cm/cm",
             units::rigidity_to_kes(b),
@@ -246,6 +284,9 @@ fn virtual_kes_bending_test_recovers_b_and_2hb() {
             units::moment_to_kes(hb_in)
         );
         assert!((b / b_in - 1.0).abs() < 0.05, "{name}: B {b} vs {b_in}");
-        assert!((two_hb / hb_in - 1.0).abs() < 0.05, "{name}: 2HB {two_hb} vs {hb_in}");
+        assert!(
+            (two_hb / hb_in - 1.0).abs() < 0.05,
+            "{name}: 2HB {two_hb} vs {hb_in}"
+        );
     }
 }

@@ -140,7 +140,11 @@ fn hanging_strip_matches_the_catenary() {
         let exact = a * ((p.x / a).cosh() - (span / (2.0 * a)).cosh());
         worst = worst.max((p.z - exact).abs());
     }
-    eprintln!("catenary: max deviation {:.3e} m = {:.3} % of the span", worst, 100.0 * worst / span);
+    eprintln!(
+        "catenary: max deviation {:.3e} m = {:.3} % of the span",
+        worst,
+        100.0 * worst / span
+    );
     assert!(
         worst < 0.005 * span,
         "max deviation {worst} m = {:.3} % of the span",
