@@ -1010,15 +1010,13 @@ impl Solver {
         let diag = |i: usize| {
             let (mu, c) = (mass[i], params.damping * areas[i]);
             // Diagonal of −K: each slot's own δη term through M_i and M_a.
-            let mut k = 0.0;
-            for slot in 0..SLOTS {
-                let a = axial[i][slot];
-                if a == NO_NODE {
-                    continue;
-                }
-                let l = s.slot_len[i][slot];
-                k += 2.0 * s.slot_coef[i][slot] / (l * l) * 3.0 / l;
-            }
+            let k: f64 = (0..SLOTS)
+                .filter(|&slot| axial[i][slot] != NO_NODE)
+                .map(|slot| {
+                    let l = s.slot_len[i][slot];
+                    2.0 * s.slot_coef[i][slot] / (l * l) * 3.0 / l
+                })
+                .sum();
             mu + c * dt + dt * dt * k
         };
         let free = |i: usize| !cloth.is_pinned(i);
@@ -1092,8 +1090,8 @@ impl Solver {
                 if dot(&s.w_r, &s.w_r).sqrt() <= 1e-4 * r0 {
                     break;
                 }
-                for i in 0..n {
-                    z[i] = if free(i) { s.w_r[i] / diag(i) } else { 0.0 };
+                for (i, zi) in z.iter_mut().enumerate() {
+                    *zi = if free(i) { s.w_r[i] / diag(i) } else { 0.0 };
                 }
                 apply_a(&z, &mut s.w_dm, &mut t, &s.slot_coef, &s.slot_len);
                 let tt = dot(&t, &t);

@@ -94,7 +94,7 @@ fn run_xpbd(
 }
 
 /// Index of the first edge whose material angle is `angle` (rad).
-fn topo_edge_with_angle(cloth: &atelier_solver::Cloth, angle: f64) -> usize {
+fn topo_edge_with_angle(cloth: &Cloth, angle: f64) -> usize {
     cloth
         .topology()
         .edges()

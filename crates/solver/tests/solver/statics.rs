@@ -69,9 +69,9 @@ fn free_fall_with_linear_drag_converges_at_first_order() {
 
 /// The inextensible catenary with span `d` and length `l`: parameter a from l = 2a sinh(d/2a).
 fn catenary_parameter(d: f64, l: f64) -> f64 {
-    let (mut lo, mut hi) = (1e-4, 1e4);
+    let (mut lo, mut hi): (f64, f64) = (1e-4, 1e4);
     for _ in 0..200 {
-        let a = (lo * hi as f64).sqrt();
+        let a = (lo * hi).sqrt();
         if 2.0 * a * (d / (2.0 * a)).sinh() > l {
             lo = a
         } else {
