@@ -199,6 +199,7 @@ struct Scratch {
     f_m: Vec<V3>,
     p: Vec<f64>,
     p_prev: Vec<f64>,
+    p_warm: Vec<f64>,
     p_y: Vec<f64>,
     grad: Vec<f64>,
     force_per_width: Vec<f64>,
@@ -536,6 +537,7 @@ impl Solver {
             &mut s.len,
             &mut s.p,
             &mut s.p_prev,
+            &mut s.p_warm,
             &mut s.p_y,
             &mut s.grad,
             &mut s.force_per_width,
@@ -848,7 +850,7 @@ impl Solver {
         }
         let tol = params.internal_tolerance * factor * g_ref;
         self.s.p_prev.copy_from_slice(&self.s.p);
-        let warm = self.s.p_prev.clone();
+        self.s.p_warm.copy_from_slice(&self.s.p);
         let mut e_old = e_start;
         let mut iterations = 0;
         match params.internal_method {
@@ -921,7 +923,7 @@ impl Solver {
                 if self.energy(cloth) > e_start * (1.0 + 1e-9) {
                     // Worse than the warm start (a step too long for this geometry): keep the
                     // warm start and re-estimate the step next time.
-                    self.s.p.copy_from_slice(&warm);
+                    self.s.p.copy_from_slice(&self.s.p_warm);
                     self.gather(cloth, diagonals);
                     self.lambda = None;
                 }
