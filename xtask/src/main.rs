@@ -41,6 +41,10 @@ enum FigureSet {
     Solver,
 }
 
+/// A figure set's entry point: draw everything from the repository root into a folder, return
+/// the files written.
+type DrawAll = fn(&Path, &Path) -> Result<Vec<PathBuf>>;
+
 fn repository_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
@@ -49,7 +53,7 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Figures { which, out } => {
-            let (name, draw_all): (&str, fn(&Path, &Path) -> Result<Vec<PathBuf>>) = match which {
+            let (name, draw_all): (&str, DrawAll) = match which {
                 FigureSet::Fabric => ("fabric", figures_fabric::draw_all),
                 FigureSet::Solver => ("solver", figures_solver::draw_all),
             };

@@ -95,6 +95,7 @@ pub struct Cloth {
     colour_edge: Vec<u32>,
     axial_list: Vec<u32>,
     diagonal_list: Vec<u32>,
+    phase_slot: Vec<u32>,
     shear: ShearCurve,
     mass: Vec<f64>,
     inv_mass: Vec<f64>,
@@ -229,6 +230,12 @@ impl Cloth {
         }
         let (axial_list, diagonal_list): (Vec<u32>, Vec<u32>) = (0..topology.edges().len() as u32)
             .partition(|&e| topology.edges()[e as usize].kind != EdgeKind::Diagonal);
+        let mut phase_slot = vec![0u32; topology.edges().len()];
+        for list in [&axial_list, &diagonal_list] {
+            for (k, &e) in list.iter().enumerate() {
+                phase_slot[e as usize] = k as u32;
+            }
+        }
         Ok(Self {
             shear: ShearCurve::from_fabric(fabric),
             topology,
@@ -240,6 +247,7 @@ impl Cloth {
             edge_width,
             colours,
             colour_edge,
+            phase_slot,
             axial_list,
             diagonal_list,
             mass,
@@ -403,6 +411,12 @@ impl Cloth {
     /// Indices of the axial edges.
     pub fn axial_edge_list(&self) -> &[u32] {
         &self.axial_list
+    }
+
+    /// Position of each edge in its class's list ([`Self::axial_edge_list`] or
+    /// [`Self::diagonal_edge_list`]).
+    pub fn phase_slots(&self) -> &[u32] {
+        &self.phase_slot
     }
 
     /// Indices of the diagonal edges.

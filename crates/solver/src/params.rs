@@ -92,7 +92,7 @@ pub struct StepParams {
     /// times its value with all forces zero (the thesis stops on E's relative change, which
     /// stalls when E cannot reach zero; see `docs/solver.md`). Range (0, 1); default 1e-4.
     pub internal_tolerance: f64,
-    /// Iteration cap for the internal forces, per phase. Range ≥ 1; default 30 (the forces are
+    /// Iteration cap for the internal forces, per phase. Range ≥ 1; default 10 (the forces are
     /// warm-started, so a moving cloth converges over steps).
     pub internal_max_iterations: usize,
     /// Shape-constraint method. Default `Chebyshev { rho: 0.99 }`.
@@ -149,7 +149,7 @@ impl Default for StepParams {
             internal_method: InternalMethod::Accelerated,
             internal_step: 1.0,
             internal_tolerance: 1e-4,
-            internal_max_iterations: 30,
+            internal_max_iterations: 10,
             shape_method: ShapeMethod::Chebyshev { rho: 0.99 },
             shape_step: 1.0,
             shape_tolerance: 1e-6,
