@@ -29,7 +29,7 @@ type V3 = Vector3<f64>;
 type ChunkItem<'a> = (usize, ((&'a mut [f64], &'a mut [f64]), &'a mut [f64; 2]));
 
 /// Below this many items a loop runs on one thread (rayon's overhead would dominate).
-const PAR_MIN: usize = 4096;
+const PAR_MIN: usize = 1024;
 /// Chunk size of the deterministic reductions (fixed, so sums do not depend on thread count).
 const SUM_CHUNK: usize = 2048;
 
@@ -270,6 +270,16 @@ fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync + Send) {
     } else {
         out.iter_mut().enumerate().for_each(|(i, o)| *o = f(i));
     }
+}
+
+/// `(Jᵀ x)_i` for the length constraints: the sum over the edges at node `i` of `x_e` times the
+/// edge's unit direction, signed −1 where `i` is the edge's first node (∂l/∂r_a = −d).
+fn jacobian_transpose(cloth: &Cloth, cdir: &[V3], x: &[f64], i: usize) -> V3 {
+    cloth
+        .incidence(i)
+        .iter()
+        .map(|inc| cdir[inc.edge as usize] * (-inc.sign * x[inc.edge as usize]))
+        .sum()
 }
 
 /// A bending characteristic with the step's regularisation: stick slope and reversal dead band
@@ -976,26 +986,25 @@ impl Solver {
             // Fused: gradient at y, projected step, optimality and restart measures.
             {
                 let (f_m, dir, y) = (&s.f_m, &s.dir, &s.ph_y);
-                let body =
-                    |(c, ((p, prev), out)): ChunkItem<'_>| {
-                        let (mut norm2, mut restart) = (0.0, 0.0);
-                        for (k, (pk, prevk)) in p.iter_mut().zip(prev.iter_mut()).enumerate() {
-                            let idx = c * SUM_CHUNK + k;
-                            let e = list[idx] as usize;
-                            let (a, b) = (edges[e].a as usize, edges[e].b as usize);
-                            let fa = if inv[a] > 0.0 { f_m[a] } else { V3::zeros() };
-                            let fb = if inv[b] > 0.0 { f_m[b] } else { V3::zeros() };
-                            let g = (fa - fb).dot(&dir[e]);
-                            let yk = y[idx];
-                            let pg = if yk > 0.0 { g } else { g.min(0.0) };
-                            norm2 += pg * pg;
-                            let new = (yk - gamma * g).max(0.0);
-                            restart += (yk - new) * (new - *pk);
-                            *prevk = *pk;
-                            *pk = new;
-                        }
-                        *out = [norm2, restart];
-                    };
+                let body = |(c, ((p, prev), out)): ChunkItem<'_>| {
+                    let (mut norm2, mut restart) = (0.0, 0.0);
+                    for (k, (pk, prevk)) in p.iter_mut().zip(prev.iter_mut()).enumerate() {
+                        let idx = c * SUM_CHUNK + k;
+                        let e = list[idx] as usize;
+                        let (a, b) = (edges[e].a as usize, edges[e].b as usize);
+                        let fa = if inv[a] > 0.0 { f_m[a] } else { V3::zeros() };
+                        let fb = if inv[b] > 0.0 { f_m[b] } else { V3::zeros() };
+                        let g = (fa - fb).dot(&dir[e]);
+                        let yk = y[idx];
+                        let pg = if yk > 0.0 { g } else { g.min(0.0) };
+                        norm2 += pg * pg;
+                        let new = (yk - gamma * g).max(0.0);
+                        restart += (yk - new) * (new - *pk);
+                        *prevk = *pk;
+                        *pk = new;
+                    }
+                    *out = [norm2, restart];
+                };
                 let zipped = s
                     .ph_p
                     .par_chunks_mut(SUM_CHUNK)
@@ -1468,7 +1477,6 @@ impl Solver {
         cg_tol: f64,
     ) -> usize {
         let topo = cloth.topology();
-        let edges = topo.edges();
         let inv = cloth.inverse_masses();
         let n = inv.len();
         let sqrt_w = |i: usize| inv[i].sqrt();
@@ -1477,7 +1485,7 @@ impl Solver {
         let eps = 1e-10 * mean_diag;
         // out = (W^½ Jᵀ J W^½ + ε) y, with q_e = J_e W^½ y.
         fn apply(
-            topo: &atelier_grid::ClothTopology,
+            cloth: &Cloth,
             inv: &[f64],
             cdir: &[V3],
             eps: f64,
@@ -1485,38 +1493,20 @@ impl Solver {
             q: &mut [f64],
             out: &mut [V3],
         ) {
-            let edges = topo.edges();
+            let edges = cloth.topology().edges();
             fill(q, |e| {
                 let (a, b) = (edges[e].a as usize, edges[e].b as usize);
                 cdir[e].dot(&(y[b] * inv[b].sqrt() - y[a] * inv[a].sqrt()))
             });
             let q: &[f64] = q;
             fill(out, |i| {
-                let mut acc = V3::zeros();
-                for &e in topo.incident_edges(i) {
-                    let sign = if edges[e as usize].a as usize == i {
-                        -1.0
-                    } else {
-                        1.0
-                    };
-                    acc += cdir[e as usize] * (sign * q[e as usize]);
-                }
-                acc * inv[i].sqrt() + y[i] * eps
+                jacobian_transpose(cloth, cdir, q, i) * inv[i].sqrt() + y[i] * eps
             });
         }
         let (c, cdir) = (&s.c, &s.cdir);
         // rhs = −W^½ Jᵀ C, kept in r; x (here `pred` reused as y) starts at 0.
         fill(&mut s.r, |i| {
-            let mut acc = V3::zeros();
-            for &e in topo.incident_edges(i) {
-                let sign = if edges[e as usize].a as usize == i {
-                    -1.0
-                } else {
-                    1.0
-                };
-                acc += cdir[e as usize] * (sign * c[e as usize]);
-            }
-            -acc * sqrt_w(i)
+            -jacobian_transpose(cloth, cdir, c, i) * sqrt_w(i)
         });
         let diag = |i: usize| inv[i] * topo.incident_edges(i).len() as f64 * 0.5 + eps;
         s.pred.iter_mut().for_each(|y| *y = V3::zeros());
@@ -1533,7 +1523,7 @@ impl Solver {
             while iterations < max_cg {
                 iterations += 1;
                 apply(
-                    topo,
+                    cloth,
                     inv,
                     &s.cdir,
                     eps,

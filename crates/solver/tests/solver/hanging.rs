@@ -101,39 +101,44 @@ fn accelerated_internal_forces_need_fewer_iterations_than_steepest_descent() {
     assert!(fast < slow, "accelerated {fast} vs steepest {slow}");
 }
 
+/// The stress scene: a 0.5 m sheet (21 × 21 nodes) hanging from its top edge, which oscillates
+/// sideways with amplitude 0.3 m at up to 5 m/s. Returns the cloth, its initial state and the
+/// larger of the fabric's warp and weft EMT.
+fn stress_scene(name: &str) -> (Cloth, ClothState, f64) {
+    let f = fabric(name);
+    let emt = f
+        .tensile
+        .warp
+        .apex_strain()
+        .max(f.tensile.weft.apex_strain());
+    let n = 21;
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 0.5, 0.5)).expect("grid");
+    let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
+    let place = |[x, y]: [f64; 2]| Vector3::new(x, 0.0, y);
+    let frequency = 5.0 / (2.0 * std::f64::consts::PI * 0.3);
+    for i in 0..n {
+        let node = (n - 1) * n + i;
+        let p = place(cloth.topology().rest_positions()[node]);
+        let motion = PinMotion::Oscillate {
+            amplitude: [0.0, 0.3, 0.0],
+            frequency,
+        };
+        cloth.pin(node as u32, p, motion).expect("pin");
+    }
+    let state = ClothState::placed(&cloth, place);
+    (cloth, state, emt)
+}
+
 /// Scene 8: denim and silk, Δt up to 0.05 s, a clamped edge moving at 5 m/s, loosest
 /// tolerances: never a non-finite value in the state; either the strain stays bounded
 /// (< 3·EMT) or the step reports an error (and keeps the state).
 #[test]
 fn stress_never_produces_non_finite_state() {
     for name in ["denim", "silk"] {
-        let f = fabric(name);
-        let emt = f
-            .tensile
-            .warp
-            .apex_strain()
-            .max(f.tensile.weft.apex_strain());
+        let emt = stress_scene(name).2;
         for dt in [0.01, 0.02, 0.05] {
-            let n = 21;
-            let topo = ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 0.5, 0.5))
-                .expect("grid");
-            let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
-            let place = |[x, y]: [f64; 2]| Vector3::new(x, 0.0, y);
-            for i in 0..n {
-                let node = (n - 1) * n + i;
-                let p = place(cloth.topology().rest_positions()[node]);
-                cloth
-                    .pin(
-                        node as u32,
-                        p,
-                        PinMotion::Oscillate {
-                            amplitude: [0.0, 0.3, 0.0],
-                            frequency: 5.0 / (2.0 * std::f64::consts::PI * 0.3),
-                        },
-                    )
-                    .expect("pin");
-            }
-            let mut state = ClothState::placed(&cloth, place);
+            let (cloth, mut state, _) = stress_scene(name);
             let params = StepParams {
                 dt,
                 internal_tolerance: 0.5,
@@ -210,33 +215,7 @@ enum Outcome {
 /// solver at `dt`.
 fn stress_run(name: &str, which: Which, dt: f64) -> Outcome {
     use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
-    let f = fabric(name);
-    let emt = f
-        .tensile
-        .warp
-        .apex_strain()
-        .max(f.tensile.weft.apex_strain());
-    let n = 21;
-    let topo =
-        ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 0.5, 0.5)).expect("grid");
-    let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
-    let place = |[x, y]: [f64; 2]| Vector3::new(x, 0.0, y);
-    let frequency = 5.0 / (2.0 * std::f64::consts::PI * 0.3);
-    for i in 0..n {
-        let node = (n - 1) * n + i;
-        let p = place(cloth.topology().rest_positions()[node]);
-        cloth
-            .pin(
-                node as u32,
-                p,
-                PinMotion::Oscillate {
-                    amplitude: [0.0, 0.3, 0.0],
-                    frequency,
-                },
-            )
-            .expect("pin");
-    }
-    let mut state = ClothState::placed(&cloth, place);
+    let (cloth, mut state, emt) = stress_scene(name);
     let steps = (0.5 / dt).round() as usize;
     let (mut party, mut ms, mut xp) = (Solver::new(), MassSpring::new(), Xpbd::new());
     let party_params = StepParams {
