@@ -180,26 +180,38 @@ pub struct ParamError {
     pub range: &'static str,
 }
 
+/// `Ok` when `ok` holds and `value` is finite, else the error naming the field and its range.
+pub(crate) fn check(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    range: &'static str,
+) -> Result<(), ParamError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError { name, value, range })
+    }
+}
+
+/// The fields every solver's parameters share: Δt, gravity and damping.
+pub(crate) fn check_motion(dt: f64, gravity: [f64; 3], damping: f64) -> Result<(), ParamError> {
+    check("dt", dt, dt > 0.0 && dt <= 0.1, "(0, 0.1] s")?;
+    for g in gravity {
+        check("gravity", g, g.abs() <= 1e3, "|g| ≤ 1000 m/s²")?;
+    }
+    check(
+        "damping",
+        damping,
+        (0.0..=1e3).contains(&damping),
+        "[0, 1000] kg/(m²·s)",
+    )
+}
+
 impl StepParams {
     /// Check every field against its range.
     pub fn validate(&self) -> Result<(), ParamError> {
-        let check = |name, value: f64, ok: bool, range| {
-            if ok && value.is_finite() {
-                Ok(())
-            } else {
-                Err(ParamError { name, value, range })
-            }
-        };
-        check("dt", self.dt, self.dt > 0.0 && self.dt <= 0.1, "(0, 0.1] s")?;
-        for g in self.gravity {
-            check("gravity", g, g.abs() <= 1e3, "|g| ≤ 1000 m/s²")?;
-        }
-        check(
-            "damping",
-            self.damping,
-            (0.0..=1e3).contains(&self.damping),
-            "[0, 1000] kg/(m²·s)",
-        )?;
+        check_motion(self.dt, self.gravity, self.damping)?;
         check(
             "internal_step",
             self.internal_step,

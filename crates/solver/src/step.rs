@@ -247,6 +247,17 @@ fn resize<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
     }
 }
 
+/// ½ Σ |f_i|² over the free nodes (inverse mass > 0), summed deterministically.
+fn free_energy(chunk: &mut Vec<f64>, f: &[V3], inv: &[f64]) -> f64 {
+    0.5 * det_sum(chunk, f.len(), |i| {
+        if inv[i] > 0.0 {
+            f[i].norm_squared()
+        } else {
+            0.0
+        }
+    })
+}
+
 /// Deterministic sum of `f(i)` for `i < n`: fixed chunks summed in parallel, then in order.
 fn det_sum(chunk: &mut Vec<f64>, n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
     let chunks = n.div_ceil(SUM_CHUNK);
@@ -768,25 +779,12 @@ impl Solver {
 
     /// E = ½ Σ over free nodes |F^m|².
     fn energy(&mut self, cloth: &Cloth) -> f64 {
-        let (f_m, inv) = (&self.s.f_m, cloth.inverse_masses());
-        0.5 * det_sum(&mut self.s.chunk, f_m.len(), |i| {
-            if inv[i] > 0.0 {
-                f_m[i].norm_squared()
-            } else {
-                0.0
-            }
-        })
+        free_energy(&mut self.s.chunk, &self.s.f_m, cloth.inverse_masses())
     }
 
+    /// E at p = 0: ½ Σ over free nodes of the squared external-plus-bending force.
     fn energy_at_zero(&mut self, cloth: &Cloth) -> f64 {
-        let (f, inv) = (&self.s.f_sum, cloth.inverse_masses());
-        0.5 * det_sum(&mut self.s.chunk, f.len(), |i| {
-            if inv[i] > 0.0 {
-                f[i].norm_squared()
-            } else {
-                0.0
-            }
-        })
+        free_energy(&mut self.s.chunk, &self.s.f_sum, cloth.inverse_masses())
     }
 
     /// ∂E/∂p_e = (F^m_a [a free] − F^m_b [b free])·d_e for the edges of one phase.

@@ -59,7 +59,6 @@ use atelier_grid::NO_NODE;
 use nalgebra::Vector3;
 
 use crate::cloth::Cloth;
-use crate::params::ParamError;
 use crate::state::ClothState;
 use crate::step::{Stage, StepError};
 
@@ -189,20 +188,6 @@ pub(crate) fn resize<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
 pub(crate) fn first_non_finite(v: &[V3]) -> Option<usize> {
     v.iter()
         .position(|x| !(x.x.is_finite() && x.y.is_finite() && x.z.is_finite()))
-}
-
-/// Check a parameter against its range (the same error type as [`crate::StepParams`]).
-pub(crate) fn check(
-    name: &'static str,
-    value: f64,
-    ok: bool,
-    range: &'static str,
-) -> Result<(), ParamError> {
-    if ok && value.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError { name, value, range })
-    }
 }
 
 /// The checks shared by every baseline before a step: the state matches the cloth and its

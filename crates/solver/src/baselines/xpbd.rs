@@ -35,11 +35,11 @@ use atelier_grid::NO_NODE;
 use serde::{Deserialize, Serialize};
 
 use super::{
-    BaselineReport, Hinge, V3, check, check_input, fill_hinges, fill_stiffness, first_non_finite,
+    BaselineReport, Hinge, V3, check_input, fill_hinges, fill_stiffness, first_non_finite,
     non_finite, report, resize,
 };
 use crate::cloth::Cloth;
-use crate::params::ParamError;
+use crate::params::{ParamError, check, check_motion};
 use crate::state::ClothState;
 use crate::step::{Stage, StepError};
 
@@ -86,16 +86,7 @@ impl Default for XpbdParams {
 impl XpbdParams {
     /// Check every field against its range.
     pub fn validate(&self) -> Result<(), ParamError> {
-        check("dt", self.dt, self.dt > 0.0 && self.dt <= 0.1, "(0, 0.1] s")?;
-        for g in self.gravity {
-            check("gravity", g, g.abs() <= 1e3, "|g| ≤ 1000 m/s²")?;
-        }
-        check(
-            "damping",
-            self.damping,
-            (0.0..=1e3).contains(&self.damping),
-            "[0, 1000] kg/(m²·s)",
-        )?;
+        check_motion(self.dt, self.gravity, self.damping)?;
         check(
             "substeps",
             self.substeps as f64,
