@@ -543,12 +543,16 @@ mod tests {
             };
             assert_relative_eq!(e.material_angle, expect, epsilon = 1e-12);
         }
-        // Triangles counter-clockwise.
+        assert_counter_clockwise(&t);
+    }
+
+    /// Every triangle has positive signed area in the pattern plane.
+    fn assert_counter_clockwise(t: &ClothTopology) {
         for tri in t.triangles() {
             let p = tri.map(|k| t.rest_positions()[k as usize]);
             let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
                 - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
-            assert!(area > 0.0);
+            assert!(area > 0.0, "triangle {tri:?} has area {area}");
         }
     }
 
@@ -566,12 +570,7 @@ mod tests {
         let exact = PI * (0.3175f64.powi(2) - 0.0635f64.powi(2));
         // Polygonal rings: area within 0.2 % of the circle annulus for 60 sectors.
         assert_relative_eq!(t.area(), exact, max_relative = 2e-3);
-        for tri in t.triangles() {
-            let p = tri.map(|k| t.rest_positions()[k as usize]);
-            let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
-                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
-            assert!(area > 0.0);
-        }
+        assert_counter_clockwise(&t);
     }
 
     #[test]
