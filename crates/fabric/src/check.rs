@@ -9,7 +9,7 @@ use serde::{Deserialize, Deserializer};
 use crate::error::{ErrorKind, InvalidValue};
 
 /// A finite value ≥ 0.
-pub(crate) fn non_negative_value(v: f64) -> Result<f64, InvalidValue> {
+pub fn non_negative_value(v: f64) -> Result<f64, InvalidValue> {
     if !v.is_finite() {
         Err(InvalidValue::new(
             ErrorKind::NotFinite,
@@ -28,7 +28,7 @@ pub(crate) fn non_negative_value(v: f64) -> Result<f64, InvalidValue> {
 }
 
 /// A finite value > 0.
-pub(crate) fn positive_value(v: f64) -> Result<f64, InvalidValue> {
+pub fn positive_value(v: f64) -> Result<f64, InvalidValue> {
     let v = non_negative_value(v)?;
     if v == 0.0 {
         Err(InvalidValue::new(
@@ -41,22 +41,26 @@ pub(crate) fn positive_value(v: f64) -> Result<f64, InvalidValue> {
     }
 }
 
-pub(crate) fn positive<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+/// `deserialize_with`: a finite value > 0.
+pub fn positive<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     positive_value(f64::deserialize(d)?).map_err(D::Error::custom)
 }
 
-pub(crate) fn non_negative<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+/// `deserialize_with`: a finite value ≥ 0.
+pub fn non_negative<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     non_negative_value(f64::deserialize(d)?).map_err(D::Error::custom)
 }
 
-pub(crate) fn opt_positive<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+/// `deserialize_with`: an optional finite value > 0.
+pub fn opt_positive<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
     Option::<f64>::deserialize(d)?
         .map(positive_value)
         .transpose()
         .map_err(D::Error::custom)
 }
 
-pub(crate) fn opt_non_negative<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+/// `deserialize_with`: an optional finite value ≥ 0.
+pub fn opt_non_negative<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
     Option::<f64>::deserialize(d)?
         .map(non_negative_value)
         .transpose()
@@ -77,7 +81,8 @@ pub(crate) fn opt_locking_angle<'de, D: Deserializer<'de>>(d: D) -> Result<Optio
     Ok(v)
 }
 
-pub(crate) fn non_empty<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+/// `deserialize_with`: a string that is not blank.
+pub fn non_empty<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     let s = String::deserialize(d)?;
     if s.trim().is_empty() {
         return Err(D::Error::custom(InvalidValue::new(
@@ -97,13 +102,15 @@ pub(crate) fn branch<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(f64, f64)>,
 }
 
 /// Types whose fields must agree with each other; checked right after parsing.
-pub(crate) trait Validate {
+pub trait Validate {
+    /// Check the fields against each other; the error names the field path below `self`.
     fn validate(&self) -> Result<(), InvalidValue>;
 }
 
 /// Implement `Deserialize` (and `Serialize`) for a type declared with
 /// `#[derive(Serialize, Deserialize)] #[serde(remote = "Self")]`: the derived code reads the
 /// fields, then [`Validate::validate`] runs, so its error carries the position of the value.
+#[macro_export]
 macro_rules! validated {
     ($t:ty) => {
         impl<'de> serde::Deserialize<'de> for $t {
@@ -120,4 +127,4 @@ macro_rules! validated {
         }
     };
 }
-pub(crate) use validated;
+pub use validated;

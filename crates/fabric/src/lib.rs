@@ -26,7 +26,7 @@
 
 pub mod anisotropy;
 pub mod bending;
-pub(crate) mod check;
+pub mod check;
 pub mod error;
 pub mod fabric;
 pub mod files;

@@ -1,13 +1,20 @@
 //! # atelier-grid
 //!
-//! Boundary-fitted structured grids for cloth (thesis §4; `method.md` §4). This crate owns the
-//! cooked cloth topology ([`ClothTopology`]) that the solver consumes. For now it builds it from
-//! structured grids given directly — a rectangular sheet and an annulus (the drape disk); the
-//! gridding of sewing patterns (Coons patches, improvement, seams, darts) comes with its issue and
-//! produces the same type.
+//! Boundary-fitted structured grids for cloth and bodies (thesis §4; `method.md` §4): the initial
+//! grid by arc-length spacing and Coons patches ([`coons`]), its improvement by smoothness, shear
+//! and spacing energies on a plane, a height field or a range image ([`improve`]), sewing patterns
+//! with teams, darts, pleats and seams ([`pattern`]), bodies from front and back range images
+//! ([`range`]), grid quality ([`quality`]), and the cooked cloth topology the solver consumes
+//! ([`ClothTopology`]).
 
+pub mod coons;
+pub mod improve;
+pub mod patch;
+pub mod range;
 pub mod topology;
 
+pub use improve::{HeightField, ImproveParams, ImproveReport, Plane, Surface, improve};
+pub use patch::Patch;
 pub use topology::{
     Cell, ClothTopology, Edge, EdgeKind, NO_NODE, SLOTS, StructuredGrid, TopologyError,
 };
