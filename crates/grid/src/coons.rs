@@ -7,7 +7,10 @@
 /// Points `n ≥ 2` evenly spaced by arc length along the polyline `points` (both ends included).
 /// A polyline of zero length gives `n` copies of its first point.
 pub fn resample<const D: usize>(points: &[[f64; D]], n: usize) -> Vec<[f64; D]> {
-    assert!(n >= 2 && !points.is_empty(), "resample needs n ≥ 2 and a point");
+    assert!(
+        n >= 2 && !points.is_empty(),
+        "resample needs n ≥ 2 and a point"
+    );
     let cumulative = arc_lengths(points);
     let total = *cumulative.last().unwrap_or(&0.0);
     let mut out = Vec::with_capacity(n);

@@ -10,11 +10,14 @@
 pub mod coons;
 pub mod improve;
 pub mod patch;
+pub mod pattern;
+pub mod quality;
 pub mod range;
 pub mod topology;
 
 pub use improve::{HeightField, ImproveParams, ImproveReport, Plane, Surface, improve};
 pub use patch::Patch;
+pub use quality::{GridQuality, Stats};
 pub use topology::{
-    Cell, ClothTopology, Edge, EdgeKind, NO_NODE, SLOTS, StructuredGrid, TopologyError,
+    Cell, ClothTopology, Edge, EdgeKind, NO_NODE, Quad, SLOTS, StructuredGrid, TopologyError,
 };

@@ -8,6 +8,7 @@
 //! Triangles are counter-clockwise in the pattern plane, so a sheet's normal is the pattern
 //! plane's +z wherever the cloth is placed flat.
 
+use std::collections::HashMap;
 use std::f64::consts::PI;
 
 /// Marks an absent neighbour.
@@ -166,6 +167,16 @@ pub enum TopologyError {
         /// y.
         y: f64,
     },
+    /// A quad names a node that does not exist.
+    #[error("cell {cell} names node {node}, but there are only {count} nodes")]
+    NoSuchNode {
+        /// Cell index.
+        cell: usize,
+        /// The node named.
+        node: u32,
+        /// Nodes given.
+        count: usize,
+    },
     /// Two nodes of an edge coincide.
     #[error("edge {a}–{b} has zero length")]
     ZeroLength {
@@ -175,15 +186,27 @@ pub enum TopologyError {
         b: u32,
     },
     /// A cell is degenerate or folded against the others.
-    #[error("cell at ({i}, {j}) is degenerate or inverted (signed area {area})")]
+    #[error("cell {cell} is degenerate or inverted (signed area {area})")]
     BadCell {
-        /// u index.
-        i: usize,
-        /// v index.
-        j: usize,
+        /// Cell index (row by row for a structured grid).
+        cell: usize,
         /// Its signed area relative to the grid's orientation, m².
         area: f64,
     },
+    /// No cell has an area (nothing to build).
+    #[error("no cell with a positive area")]
+    Empty,
+}
+
+/// One quadrilateral of a grid, `q0 q1 q2 q3` with u from q0 to q1 and v from q0 to q3.
+/// Corners may repeat (a dart apex merges nodes): a quad with three distinct corners becomes a
+/// triangle without a shear cell, one with fewer is dropped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Quad {
+    /// Corner nodes.
+    pub nodes: [u32; 4],
+    /// Split along `q1–q3` instead of `q0–q2` (alternate in a checkerboard).
+    pub flip: bool,
 }
 
 /// The cloth topology: immutable, shared by every state of the same garment.
@@ -219,8 +242,37 @@ impl ClothTopology {
                 found: g.positions.len(),
             });
         }
-        if let Some((node, p)) = g
-            .positions
+        let cells_u = if g.periodic_u { nu } else { nu - 1 };
+        let quads: Vec<Quad> = (0..nv - 1)
+            .flat_map(|j| {
+                (0..cells_u).map(move |i| Quad {
+                    nodes: [
+                        g.index(i, j),
+                        g.index(i + 1, j),
+                        g.index(i + 1, j + 1),
+                        g.index(i, j + 1),
+                    ]
+                    .map(|k| k as u32),
+                    flip: (i + j) % 2 == 1,
+                })
+            })
+            .collect();
+        let mut topo = Self::from_quads(&g.positions, &quads, g.grain_angle)?;
+        topo.grid = Some((nu, nv, g.periodic_u));
+        Ok(topo)
+    }
+
+    /// Cook any quadrilateral grid: nodes at `positions` (pattern plane, m), cells as [`Quad`]s
+    /// (their u and v sides give each node's axial slots; the first quad to claim a slot keeps
+    /// it), the warp at `grain_angle` from the pattern x axis. Edges are shared between cells;
+    /// every full cell gets both diagonals and a shear [`Cell`]; node areas are a quarter of each
+    /// full cell and a third of each triangle.
+    pub fn from_quads(
+        positions: &[[f64; 2]],
+        quads: &[Quad],
+        grain_angle: f64,
+    ) -> Result<Self, TopologyError> {
+        if let Some((node, p)) = positions
             .iter()
             .enumerate()
             .find(|(_, p)| !(p[0].is_finite() && p[1].is_finite()))
@@ -231,15 +283,23 @@ impl ClothTopology {
                 y: p[1],
             });
         }
-        let n = nu * nv;
-        let cells_u = if g.periodic_u { nu } else { nu - 1 };
-        let grain = [g.grain_angle.cos(), g.grain_angle.sin()];
+        let n = positions.len();
+        for (cell, q) in quads.iter().enumerate() {
+            if let Some(&node) = q.nodes.iter().find(|&&k| k as usize >= n) {
+                return Err(TopologyError::NoSuchNode {
+                    cell,
+                    node,
+                    count: n,
+                });
+            }
+        }
+        let grain = [grain_angle.cos(), grain_angle.sin()];
         let mut topo = Self {
-            rest: g.positions.clone(),
+            rest: positions.to_vec(),
             edges: Vec::new(),
             axial: vec![[NO_NODE; SLOTS]; n],
             axial_edge: vec![[NO_NODE; SLOTS]; n],
-            triangles: Vec::with_capacity(2 * cells_u * (nv - 1)),
+            triangles: Vec::with_capacity(2 * quads.len()),
             node_area: vec![0.0; n],
             incidence_offsets: Vec::new(),
             incidence: Vec::new(),
@@ -247,128 +307,151 @@ impl ClothTopology {
             tri_incidence: Vec::new(),
             cells: Vec::new(),
             edge_cells: Vec::new(),
-            grid: Some((nu, nv, g.periodic_u)),
+            grid: None,
         };
-        let add_edge =
-            |topo: &mut Self, a: usize, b: usize, kind: EdgeKind| -> Result<u32, TopologyError> {
-                let (pa, pb) = (g.positions[a], g.positions[b]);
+        let mut index: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut edge =
+            |topo: &mut Self, a: u32, b: u32, kind: EdgeKind| -> Result<u32, TopologyError> {
+                if let Some(&e) = index.get(&(a.min(b), a.max(b))) {
+                    return Ok(e);
+                }
+                let (pa, pb) = (positions[a as usize], positions[b as usize]);
                 let e = [pb[0] - pa[0], pb[1] - pa[1]];
                 let len = e[0].hypot(e[1]);
                 if len <= 0.0 {
-                    return Err(TopologyError::ZeroLength {
-                        a: a as u32,
-                        b: b as u32,
-                    });
+                    return Err(TopologyError::ZeroLength { a, b });
                 }
                 let cross = grain[0] * e[1] - grain[1] * e[0];
                 let dot = grain[0] * e[0] + grain[1] * e[1];
                 let mut angle = cross.atan2(dot).rem_euclid(PI);
-                if angle >= PI {
+                // Rounding can put a warp edge just below π; the angle is taken modulo π.
+                if angle >= PI - 1e-12 {
                     angle = 0.0;
                 }
                 topo.edges.push(Edge {
-                    a: a as u32,
-                    b: b as u32,
+                    a,
+                    b,
                     kind,
                     rest_length: len,
                     material_angle: angle,
                 });
-                Ok((topo.edges.len() - 1) as u32)
+                let id = (topo.edges.len() - 1) as u32;
+                index.insert((a.min(b), a.max(b)), id);
+                Ok(id)
             };
-        // Axial edges and their slots.
-        let mut u_edge = vec![NO_NODE; cells_u * nv];
-        let mut v_edge = vec![NO_NODE; nu * (nv - 1)];
-        for j in 0..nv {
-            for i in 0..cells_u {
-                let (a, b) = (g.index(i, j), g.index(i + 1, j));
-                let e = add_edge(&mut topo, a, b, EdgeKind::AxialU)?;
-                u_edge[j * cells_u + i] = e;
-                topo.axial[a][0] = b as u32;
-                topo.axial_edge[a][0] = e;
-                topo.axial[b][1] = a as u32;
-                topo.axial_edge[b][1] = e;
+        // Axial slot: `a`'s slot `fwd` is `b`, `b`'s slot `fwd ^ 1` is `a`, first claim wins.
+        let claim = |topo: &mut Self, a: u32, b: u32, e: u32, fwd: usize| {
+            let (a, b) = (a as usize, b as usize);
+            if topo.axial[a][fwd] == NO_NODE {
+                topo.axial[a][fwd] = b as u32;
+                topo.axial_edge[a][fwd] = e;
             }
-        }
-        for j in 0..nv - 1 {
-            for i in 0..nu {
-                let (a, b) = (g.index(i, j), g.index(i, j + 1));
-                let e = add_edge(&mut topo, a, b, EdgeKind::AxialV)?;
-                v_edge[j * nu + i] = e;
-                topo.axial[a][2] = b as u32;
-                topo.axial_edge[a][2] = e;
-                topo.axial[b][3] = a as u32;
-                topo.axial_edge[b][3] = e;
+            if topo.axial[b][fwd ^ 1] == NO_NODE {
+                topo.axial[b][fwd ^ 1] = a as u32;
+                topo.axial_edge[b][fwd ^ 1] = e;
             }
-        }
-        // Cells: orientation from the first cell, diagonals, triangles, areas.
-        let signed_area = |q: [usize; 4]| -> f64 {
-            let p = q.map(|k| g.positions[k]);
-            0.5 * (0..4)
+        };
+        let signed_area = |p: &[[f64; 2]]| -> f64 {
+            0.5 * (0..p.len())
                 .map(|k| {
-                    let (a, b) = (p[k], p[(k + 1) % 4]);
+                    let (a, b) = (p[k], p[(k + 1) % p.len()]);
                     a[0] * b[1] - b[0] * a[1]
                 })
                 .sum::<f64>()
         };
-        let quad = |i: usize, j: usize| {
-            [
-                g.index(i, j),
-                g.index(i + 1, j),
-                g.index(i + 1, j + 1),
-                g.index(i, j + 1),
-            ]
+        let orientation = quads
+            .iter()
+            .map(|q| signed_area(&q.nodes.map(|k| positions[k as usize])))
+            .find(|a| *a != 0.0 && a.is_finite())
+            .ok_or(TopologyError::Empty)?
+            .signum();
+        let ccw = |t: [u32; 3]| -> [u32; 3] {
+            if orientation > 0.0 {
+                t
+            } else {
+                [t[0], t[2], t[1]]
+            }
         };
-        let orientation = signed_area(quad(0, 0)).signum();
-        for j in 0..nv - 1 {
-            for i in 0..cells_u {
-                let q = quad(i, j);
-                let area = signed_area(q) * orientation;
-                if area.is_nan() || area <= 0.0 {
-                    return Err(TopologyError::BadCell { i, j, area });
-                }
-                let plus = add_edge(&mut topo, q[0], q[2], EdgeKind::Diagonal)?;
-                let minus = add_edge(&mut topo, q[1], q[3], EdgeKind::Diagonal)?;
-                let p = q.map(|k| g.positions[k]);
-                let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
-                let su = {
-                    let (m0, m1) = (mid(p[0], p[3]), mid(p[1], p[2]));
-                    [m1[0] - m0[0], m1[1] - m0[1]]
-                };
-                let sv = {
-                    let (m0, m1) = (mid(p[0], p[1]), mid(p[3], p[2]));
-                    [m1[0] - m0[0], m1[1] - m0[1]]
-                };
-                let rest_angle = (su[0] * sv[1] - su[1] * sv[0])
-                    .abs()
-                    .atan2(su[0] * sv[0] + su[1] * sv[1]);
-                let next_i = if g.periodic_u { (i + 1) % nu } else { i + 1 };
-                topo.cells.push(Cell {
-                    nodes: q.map(|k| k as u32),
-                    u_edges: [u_edge[j * cells_u + i], u_edge[(j + 1) * cells_u + i]],
-                    v_edges: [v_edge[j * nu + i], v_edge[j * nu + next_i]],
-                    diagonals: [plus, minus],
-                    rest_angle,
-                    area,
-                });
-                // Counter-clockwise in the pattern plane.
-                let ccw = |t: [usize; 3]| -> [u32; 3] {
-                    let t = if orientation > 0.0 {
-                        t
+        for (ci, quad) in quads.iter().enumerate() {
+            let q = quad.nodes;
+            // Sides: (from, to, slot of `to` seen from `from`).
+            let sides = [
+                (q[0], q[1], 0),
+                (q[3], q[2], 0),
+                (q[0], q[3], 2),
+                (q[1], q[2], 2),
+            ];
+            let mut side_edges = [NO_NODE; 4];
+            for (k, &(a, b, fwd)) in sides.iter().enumerate() {
+                if a != b {
+                    let kind = if fwd == 0 {
+                        EdgeKind::AxialU
                     } else {
-                        [t[0], t[2], t[1]]
+                        EdgeKind::AxialV
                     };
-                    t.map(|k| k as u32)
-                };
-                if (i + j) % 2 == 0 {
-                    topo.triangles.push(ccw([q[0], q[1], q[2]]));
-                    topo.triangles.push(ccw([q[0], q[2], q[3]]));
-                } else {
-                    topo.triangles.push(ccw([q[0], q[1], q[3]]));
-                    topo.triangles.push(ccw([q[1], q[2], q[3]]));
+                    let e = edge(&mut topo, a, b, kind)?;
+                    claim(&mut topo, a, b, e, fwd);
+                    side_edges[k] = e;
                 }
-                for k in q {
-                    topo.node_area[k] += 0.25 * area;
+            }
+            let mut distinct: Vec<u32> = Vec::with_capacity(4);
+            for k in 0..4 {
+                if q[k] != q[(k + 1) % 4] && !distinct.contains(&q[k]) {
+                    distinct.push(q[k]);
                 }
+            }
+            let p: Vec<[f64; 2]> = distinct.iter().map(|&k| positions[k as usize]).collect();
+            let area = signed_area(&p) * orientation;
+            match distinct.len() {
+                4 => {}
+                3 => {
+                    if area.is_nan() || area <= 0.0 {
+                        return Err(TopologyError::BadCell { cell: ci, area });
+                    }
+                    topo.triangles
+                        .push(ccw([distinct[0], distinct[1], distinct[2]]));
+                    for &k in &distinct {
+                        topo.node_area[k as usize] += area / 3.0;
+                    }
+                    continue;
+                }
+                _ => continue,
+            }
+            if area.is_nan() || area <= 0.0 {
+                return Err(TopologyError::BadCell { cell: ci, area });
+            }
+            let plus = edge(&mut topo, q[0], q[2], EdgeKind::Diagonal)?;
+            let minus = edge(&mut topo, q[1], q[3], EdgeKind::Diagonal)?;
+            let p = q.map(|k| positions[k as usize]);
+            let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+            let su = {
+                let (m0, m1) = (mid(p[0], p[3]), mid(p[1], p[2]));
+                [m1[0] - m0[0], m1[1] - m0[1]]
+            };
+            let sv = {
+                let (m0, m1) = (mid(p[0], p[1]), mid(p[3], p[2]));
+                [m1[0] - m0[0], m1[1] - m0[1]]
+            };
+            let rest_angle = (su[0] * sv[1] - su[1] * sv[0])
+                .abs()
+                .atan2(su[0] * sv[0] + su[1] * sv[1]);
+            topo.cells.push(Cell {
+                nodes: q,
+                u_edges: [side_edges[0], side_edges[1]],
+                v_edges: [side_edges[2], side_edges[3]],
+                diagonals: [plus, minus],
+                rest_angle,
+                area,
+            });
+            if quad.flip {
+                topo.triangles.push(ccw([q[0], q[1], q[3]]));
+                topo.triangles.push(ccw([q[1], q[2], q[3]]));
+            } else {
+                topo.triangles.push(ccw([q[0], q[1], q[2]]));
+                topo.triangles.push(ccw([q[0], q[2], q[3]]));
+            }
+            for k in q {
+                topo.node_area[k as usize] += 0.25 * area;
             }
         }
         topo.build_incidence();
