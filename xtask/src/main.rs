@@ -4,8 +4,13 @@
 //!   bending loop, polar plots of the orthotropic interpolation), PNG, written atomically.
 //! - `cargo xtask figures solver [--out DIR]` — time against error of the PARTY step and the
 //!   baselines on the thesis's drape (PNG and a markdown table, also printed to stdout).
+//! - `cargo xtask figures grid [--out DIR]` — the gridding figures: pattern grids before and after
+//!   improvement, energy, quality histograms, the dress panels with seams, the body from range
+//!   images coloured by part and its error image.
 
+mod figures_body;
 mod figures_fabric;
+mod figures_grid;
 mod figures_solver;
 mod plot;
 
@@ -39,6 +44,9 @@ enum FigureSet {
     Fabric,
     /// Time against error of the PARTY step and the baselines (takes a few minutes).
     Solver,
+    /// Pattern grids before and after improvement, quality histograms, the dress panels, the
+    /// body from range images.
+    Grid,
 }
 
 /// A figure set's entry point: draw everything from the repository root into a folder, return
@@ -56,6 +64,7 @@ fn main() -> Result<()> {
             let (name, draw_all): (&str, DrawAll) = match which {
                 FigureSet::Fabric => ("fabric", figures_fabric::draw_all),
                 FigureSet::Solver => ("solver", figures_solver::draw_all),
+                FigureSet::Grid => ("grid", figures_grid::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;

@@ -120,12 +120,11 @@ pub fn coons_periodic<const D: usize>(
     );
     let (b0, t0) = (bottom[0], top[0]);
     let mut out = Vec::with_capacity(nu * nv);
-    for j in 0..nv {
+    for (j, sj) in seam.iter().enumerate() {
         let t = j as f64 / (nv - 1) as f64;
         for i in 0..nu {
             out.push(std::array::from_fn(|k| {
-                (1.0 - t) * bottom[i][k] + t * top[i][k] + seam[j][k]
-                    - ((1.0 - t) * b0[k] + t * t0[k])
+                (1.0 - t) * bottom[i][k] + t * top[i][k] + sj[k] - ((1.0 - t) * b0[k] + t * t0[k])
             }));
         }
     }
@@ -184,6 +183,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::float_cmp, reason = "the last point is copied, exactly")]
     fn resampling_is_even_by_arc_length() {
         let poly = [[0.0, 0.0], [1.0, 0.0], [1.0, 3.0]];
         let r = resample(&poly, 5);

@@ -87,18 +87,20 @@ pub struct StructuredGrid {
 
 impl StructuredGrid {
     /// A rectangle `width × height` (m) with `nu × nv` nodes, u along x, v along y, the warp
-    /// along y (so AxialV edges are warp, θ = 0, and AxialU edges weft, θ = 90°).
+    /// along y (so AxialV edges are warp, θ = 0, and AxialU edges weft, θ = 90°): the Coons
+    /// patch of its four evenly divided sides, i.e. the uniform grid.
     pub fn sheet(nu: usize, nv: usize, width: f64, height: f64) -> Self {
-        let positions = (0..nv)
-            .flat_map(|j| {
-                (0..nu).map(move |i| {
-                    [
-                        width * i as f64 / (nu.max(2) - 1) as f64,
-                        height * j as f64 / (nv.max(2) - 1) as f64,
-                    ]
-                })
-            })
-            .collect();
+        let (nu2, nv2) = (nu.max(2), nv.max(2));
+        let side = |a: [f64; 2], b: [f64; 2], n: usize| crate::coons::resample(&[a, b], n);
+        let mut positions = crate::coons::coons(
+            &side([0.0, 0.0], [width, 0.0], nu2),
+            &side([0.0, height], [width, height], nu2),
+            &side([0.0, 0.0], [0.0, height], nv2),
+            &side([width, 0.0], [width, height], nv2),
+        );
+        // Degenerate sizes (a single row or column) keep the count asked for; the topology
+        // builder rejects them.
+        positions.truncate(nu * nv);
         Self {
             nu,
             nv,
@@ -110,17 +112,27 @@ impl StructuredGrid {
 
     /// An annulus (the drape-test disk with its support hole) centred at the origin: `n_around`
     /// nodes per ring (u, periodic), `n_rings` rings (v) from `r_inner` to `r_outer` (m), the warp
-    /// along y.
+    /// along y: the periodic Coons patch of the two circles and a radial seam, i.e. the exact
+    /// polar grid (the same grid as the `Ring` pattern `fixtures/patterns/drape_annulus.ron`
+    /// before improvement).
     pub fn annulus(n_around: usize, n_rings: usize, r_inner: f64, r_outer: f64) -> Self {
-        let positions = (0..n_rings)
-            .flat_map(|j| {
-                let r = r_inner + (r_outer - r_inner) * j as f64 / (n_rings.max(2) - 1) as f64;
-                (0..n_around).map(move |i| {
+        let ring = |r: f64| -> Vec<[f64; 2]> {
+            (0..n_around)
+                .map(|i| {
                     let psi = 2.0 * PI * i as f64 / n_around as f64;
                     [r * psi.cos(), r * psi.sin()]
                 })
-            })
-            .collect();
+                .collect()
+        };
+        let positions = if n_around >= 3 && n_rings >= 2 {
+            crate::coons::coons_periodic(
+                &ring(r_inner),
+                &ring(r_outer),
+                &crate::coons::resample(&[[r_inner, 0.0], [r_outer, 0.0]], n_rings),
+            )
+        } else {
+            Vec::new()
+        };
         Self {
             nu: n_around,
             nv: n_rings,

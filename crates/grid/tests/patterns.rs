@@ -64,6 +64,11 @@ fn the_drape_annulus_starts_as_the_exact_polar_grid() {
         }
     }
     assert_eq!(p.topology.node_count(), 360);
+    // The solver's drape builder is the same grid.
+    let direct = atelier_grid::StructuredGrid::annulus(60, 6, 0.0635, 0.3175);
+    for (a, b) in direct.positions.iter().zip(&g.positions) {
+        assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12);
+    }
     // The improvement keeps the rings round: every node stays within 1 % of its ring's radius
     // spacing of the polar position's radius.
     for j in 0..6 {
