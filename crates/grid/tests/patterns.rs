@@ -425,3 +425,20 @@ fn a_seam_between_teams_of_different_counts_is_refused() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_bad_spec_built_in_code_is_an_error_not_a_panic() {
+    let mut spec = parse(&SQUARE.replace("EXTRA", "")).expect("parses");
+    if let atelier_grid::pattern::Outline::Quad { top, .. } = &mut spec.outline {
+        top[0].cells = 5;
+    }
+    let e = grid_pattern(&spec, ImproveParams::default()).expect_err("totals differ");
+    assert_eq!(e.kind, atelier_fabric::ErrorKind::Inconsistent);
+    let spec = parse(&SQUARE.replace("EXTRA", "")).expect("parses");
+    let bad = ImproveParams {
+        c2: f64::NAN,
+        ..Default::default()
+    };
+    let e = grid_pattern(&spec, bad).expect_err("NaN weight");
+    assert_eq!(e.field, "improve.c2");
+}

@@ -68,7 +68,20 @@ pub type BuildError = InvalidValue;
 
 /// Grid a pattern: the initial grid, its improvement with `params` (the file's `improve` block
 /// overrides them), the topology.
+///
+/// The spec is checked first (a spec built in code has not been through the parser's checks), so
+/// bad input is an error, never a panic.
 pub fn grid_pattern(spec: &PatternSpec, params: ImproveParams) -> Result<Panel, BuildError> {
+    atelier_fabric::check::Validate::validate(spec)?;
+    for (name, c) in [("c1", params.c1), ("c2", params.c2), ("c3", params.c3)] {
+        if !(c.is_finite() && c >= 0.0) {
+            return Err(InvalidValue::new(
+                ErrorKind::OutOfRange,
+                format!("improve.{name}"),
+                format!("weight {c} must be finite and ≥ 0"),
+            ));
+        }
+    }
     let params = spec.improve.as_ref().map_or(params, |s| ImproveParams {
         c1: s.c1,
         c2: s.c2,
