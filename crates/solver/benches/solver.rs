@@ -256,6 +256,7 @@ fn stage_medians(fixture: &Fixture, steps: usize) -> StageMedians {
             velocity: median_duration(&reports, |t| t.velocity),
             shape: median_duration(&reports, |t| t.shape),
             collision: median_duration(&reports, |t| t.collision),
+            transfer: median_duration(&reports, |t| t.transfer),
             update: median_duration(&reports, |t| t.update),
         },
         total: median_duration(&reports, |t| t.total()),

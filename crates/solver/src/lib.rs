@@ -12,6 +12,8 @@
 
 pub mod baselines;
 pub mod cloth;
+pub mod contact;
+pub mod leg;
 pub mod metrics;
 pub mod params;
 pub mod scenes;
@@ -20,6 +22,7 @@ pub mod state;
 pub mod step;
 
 pub use cloth::{Cloth, ClothError, ClothOptions, Incidence, Pin, PinMotion};
+pub use contact::BodyContact;
 pub use params::{
     ConstraintKind, InternalMethod, ParamError, ShapeMethod, StepParams, TolerancePolicy,
 };

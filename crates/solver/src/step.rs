@@ -109,8 +109,10 @@ pub struct StageTimings {
     pub velocity: Duration,
     /// Targets and constraint iterations.
     pub shape: Duration,
-    /// Collision hook.
+    /// Collision hook: the passes between shape iterations.
     pub collision: Duration,
+    /// Collision hook: the transfer of body motion before the shape constraints.
+    pub transfer: Duration,
     /// Update and diagnostics.
     pub update: Duration,
 }
@@ -118,7 +120,13 @@ pub struct StageTimings {
 impl StageTimings {
     /// Sum of all stages.
     pub fn total(&self) -> Duration {
-        self.bending + self.internal + self.velocity + self.shape + self.collision + self.update
+        self.bending
+            + self.internal
+            + self.velocity
+            + self.transfer
+            + self.shape
+            + self.collision
+            + self.update
     }
 }
 
@@ -155,6 +163,9 @@ pub struct HookContext<'a> {
     pub positions: &'a [V3],
     /// Velocities being corrected (the node moves by `velocity·dt` this step).
     pub velocities: &'a mut [V3],
+    /// Added to the velocities after the position update (zero at the start of the step): a
+    /// contact's exit velocity minus the mean velocity the node moved with (thesis (72)).
+    pub exit: &'a mut [V3],
     /// Inverse masses (0 for pinned nodes, which a hook must not move).
     pub inverse_masses: &'a [f64],
     /// Time step, s.
@@ -165,10 +176,13 @@ pub struct HookContext<'a> {
     pub pass: usize,
 }
 
-/// A collision stage called between shape-constraint iterations.
+/// The collision stages of a step: a transfer after the unconstrained velocity (the staged
+/// model's geometric stage), and a pass after each round of shape-constraint iterations.
 pub trait CollisionHook: Send {
     /// Resolve contacts by changing velocities.
     fn resolve(&mut self, ctx: HookContext<'_>);
+    /// Before the shape constraints: move the cloth with a moving body (default: nothing).
+    fn transfer(&mut self, _ctx: HookContext<'_>) {}
 }
 
 /// No collisions.
@@ -183,6 +197,7 @@ impl CollisionHook for NoCollision {
 struct Scratch {
     tri_normal: Vec<V3>,
     normal: Vec<V3>,
+    exit: Vec<V3>,
     dir: Vec<V3>,
     len: Vec<f64>,
     eta: Vec<[f64; SLOTS]>,
@@ -461,6 +476,23 @@ impl Solver {
         }
         report.timings.velocity = t0.elapsed();
 
+        // 3b. Transfer of body motion (staged collision model).
+        let t0 = Instant::now();
+        self.s.exit.iter_mut().for_each(|e| *e = V3::zeros());
+        hook.transfer(HookContext {
+            positions: &state.positions,
+            velocities: &mut self.s.vel,
+            exit: &mut self.s.exit,
+            inverse_masses: cloth.inverse_masses(),
+            dt,
+            time: state.time,
+            pass: 0,
+        });
+        if let Some(i) = first_non_finite_v(&self.s.vel) {
+            return Err(non_finite(Stage::Collision, "velocity", "node", i));
+        }
+        report.timings.transfer = t0.elapsed();
+
         // 4. Shape constraints, interleaved with collision passes.
         let t0 = Instant::now();
         report.extrapolated_edges = self.targets(cloth, state, params);
@@ -486,6 +518,7 @@ impl Solver {
             hook.resolve(HookContext {
                 positions: &state.positions,
                 velocities: &mut self.s.vel,
+                exit: &mut self.s.exit,
                 inverse_masses: cloth.inverse_masses(),
                 dt,
                 time: state.time,
@@ -531,7 +564,14 @@ impl Solver {
             }
         }
         std::mem::swap(&mut state.positions, &mut self.s.pred);
-        state.velocities.copy_from_slice(&self.s.vel);
+        for ((v, w), e) in state
+            .velocities
+            .iter_mut()
+            .zip(&self.s.vel)
+            .zip(&self.s.exit)
+        {
+            *v = w + e;
+        }
         state.axial_force.copy_from_slice(&self.s.p);
         state.shear_angle.copy_from_slice(&self.s.shear);
         self.commit_hysteresis(cloth, state, params);
@@ -553,6 +593,7 @@ impl Solver {
         resize(&mut s.tri_normal, nt, z);
         for v in [
             &mut s.normal,
+            &mut s.exit,
             &mut s.f_sum,
             &mut s.f_m,
             &mut s.vel,

@@ -3,6 +3,7 @@
 
 mod baselines;
 mod cantilever;
+mod collision;
 mod common;
 mod drape;
 mod hanging;

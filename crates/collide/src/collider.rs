@@ -1,0 +1,513 @@
+//! The collision stages of a step (thesis §5.3–5.5, `method.md` §3): the geometric transfer of
+//! body motion (staged model) and the physical collision pass (cloth against the body, cloth
+//! against itself), over plain slices.
+
+use crate::broad::{BroadKind, BroadPhase, new_broad};
+use crate::geom::V3;
+use crate::narrow::{Hit, NarrowTest, Sides, point_triangle, point_triangle_thesis};
+use crate::response::{ContactMaterial, respond};
+
+/// How collisions are computed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactParams {
+    /// Restitution ν and static friction ρ (the thesis's dress: 0.1 and 0.3).
+    pub material: ContactMaterial,
+    /// Contact skin, m: a node closer than this to a surface and approaching it is in contact.
+    pub thickness: f64,
+    /// Collide only where the cloth's normal and the body's normal agree (the thesis's
+    /// "semi-transparent" body): a garment passes through the body from outside and catches on
+    /// its inside.
+    pub one_sided: bool,
+    /// Cloth against its own triangles.
+    pub self_collision: bool,
+    /// Staged model (§5.4): transfer the body's motion to the cloth within reach before the
+    /// shape constraints; `false` is the physical model alone.
+    pub staged: bool,
+    /// The search reach of the transfer beyond the body's largest displacement in the step, m
+    /// (the thesis: 7 cm).
+    pub transfer_margin: f64,
+    /// Broad phase for the body and for the cloth.
+    pub broad: BroadKind,
+    /// Narrow-phase test (exact by default; the thesis's linear test to reproduce it).
+    pub narrow: NarrowTest,
+}
+
+impl Default for ContactParams {
+    fn default() -> Self {
+        Self {
+            material: ContactMaterial {
+                restitution: 0.1,
+                friction: 0.3,
+            },
+            thickness: 1e-3,
+            one_sided: false,
+            self_collision: false,
+            staged: true,
+            transfer_margin: 0.07,
+            broad: BroadKind::Bvh,
+            narrow: NarrowTest::Exact,
+        }
+    }
+}
+
+/// Why parameters or a body were refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ContactError {
+    /// A parameter outside its range.
+    #[error("contact parameter `{name}` = {value} is out of range ({rule})")]
+    Param {
+        /// Field.
+        name: &'static str,
+        /// Value.
+        value: f64,
+        /// The rule.
+        rule: &'static str,
+    },
+    /// Body arrays of different lengths.
+    #[error("body start has {start} vertices, end {end}")]
+    BodyMismatch {
+        /// Start positions.
+        start: usize,
+        /// End positions.
+        end: usize,
+    },
+    /// A triangle names a vertex that does not exist.
+    #[error("body triangle {triangle} names vertex {vertex}, there are {count}")]
+    BodyIndex {
+        /// Triangle.
+        triangle: usize,
+        /// Vertex named.
+        vertex: u32,
+        /// Vertices.
+        count: usize,
+    },
+    /// A non-finite body vertex.
+    #[error("body vertex {vertex} is not finite")]
+    BodyNotFinite {
+        /// Vertex.
+        vertex: usize,
+    },
+}
+
+impl ContactParams {
+    /// Check the ranges.
+    pub fn check(&self) -> Result<(), ContactError> {
+        let rules: [(&'static str, f64, bool, &'static str); 4] = [
+            (
+                "restitution",
+                self.material.restitution,
+                (0.0..=1.0).contains(&self.material.restitution),
+                "0 ≤ ν ≤ 1",
+            ),
+            (
+                "friction",
+                self.material.friction,
+                self.material.friction >= 0.0 && self.material.friction.is_finite(),
+                "ρ ≥ 0, finite",
+            ),
+            (
+                "thickness",
+                self.thickness,
+                self.thickness >= 0.0 && self.thickness.is_finite(),
+                "≥ 0 m, finite",
+            ),
+            (
+                "transfer_margin",
+                self.transfer_margin,
+                self.transfer_margin >= 0.0 && self.transfer_margin.is_finite(),
+                "≥ 0 m, finite",
+            ),
+        ];
+        for (name, value, ok, rule) in rules {
+            if !ok {
+                return Err(ContactError::Param { name, value, rule });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The cloth as a collision pass sees it.
+pub struct ClothView<'a> {
+    /// Positions at the start of the step.
+    pub positions: &'a [V3],
+    /// Velocities being corrected (a node moves by `velocity·dt`).
+    pub velocities: &'a mut [V3],
+    /// Added to the velocity after the position update: a contact's exit velocity minus the
+    /// mean velocity the node moved with.
+    pub exit: &'a mut [V3],
+    /// Inverse masses (0: pinned, never moved).
+    pub inverse_masses: &'a [f64],
+    /// The cloth's triangles (for self-collision).
+    pub triangles: &'a [[u32; 3]],
+    /// Unit node normals (for one-sided contact); may be empty when not needed.
+    pub normals: &'a [V3],
+}
+
+/// Counts of one pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PassStats {
+    /// Node–triangle pairs the broad phase returned.
+    pub candidates: usize,
+    /// Contacts with the body.
+    pub body_hits: usize,
+    /// Contacts with the cloth itself.
+    pub self_hits: usize,
+    /// Nodes the geometric transfer moved with the body.
+    pub transferred: usize,
+}
+
+struct Body {
+    start: Vec<V3>,
+    end: Vec<V3>,
+    /// Vertex velocity over the current step.
+    vel: Vec<V3>,
+    /// Vertex velocity over the previous step (zero before the first).
+    prev_vel: Vec<V3>,
+    triangles: Vec<[u32; 3]>,
+    broad: Box<dyn BroadPhase>,
+    max_displacement: f64,
+}
+
+/// The collision stages. With no body and no self-collision it holds nothing and does nothing.
+pub struct Collider {
+    params: ContactParams,
+    body: Option<Body>,
+    cloth_broad: Option<Box<dyn BroadPhase>>,
+    candidates: Vec<u32>,
+    cloth_end: Vec<V3>,
+    stats: PassStats,
+}
+
+impl Collider {
+    /// A collider with checked parameters.
+    pub fn new(params: ContactParams) -> Result<Self, ContactError> {
+        params.check()?;
+        Ok(Self {
+            params,
+            body: None,
+            cloth_broad: None,
+            candidates: Vec::new(),
+            cloth_end: Vec::new(),
+            stats: PassStats::default(),
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &ContactParams {
+        &self.params
+    }
+
+    /// Counts since the last [`Collider::take_stats`].
+    pub fn take_stats(&mut self) -> PassStats {
+        std::mem::take(&mut self.stats)
+    }
+
+    /// The body over the coming step: vertices at its start and its end, triangles with outward
+    /// (counter-clockwise) normals. The first call builds the broad phase; later calls with the
+    /// same triangles refit it.
+    pub fn set_body(
+        &mut self,
+        start: &[V3],
+        end: &[V3],
+        triangles: &[[u32; 3]],
+        dt: f64,
+    ) -> Result<(), ContactError> {
+        if start.len() != end.len() {
+            return Err(ContactError::BodyMismatch {
+                start: start.len(),
+                end: end.len(),
+            });
+        }
+        if let Some(vertex) = start
+            .iter()
+            .chain(end)
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(ContactError::BodyNotFinite {
+                vertex: vertex % start.len().max(1),
+            });
+        }
+        for (t, tri) in triangles.iter().enumerate() {
+            if let Some(&vertex) = tri.iter().find(|&&k| k as usize >= start.len()) {
+                return Err(ContactError::BodyIndex {
+                    triangle: t,
+                    vertex,
+                    count: start.len(),
+                });
+            }
+        }
+        let same = self
+            .body
+            .as_ref()
+            .is_some_and(|b| b.triangles == triangles && b.start.len() == start.len());
+        if !same {
+            self.body = Some(Body {
+                start: Vec::new(),
+                end: Vec::new(),
+                vel: vec![V3::zeros(); start.len()],
+                prev_vel: vec![V3::zeros(); start.len()],
+                triangles: triangles.to_vec(),
+                broad: new_broad(self.params.broad),
+                max_displacement: 0.0,
+            });
+        }
+        let body = self.body.as_mut().expect("set above");
+        std::mem::swap(&mut body.prev_vel, &mut body.vel);
+        body.start.clear();
+        body.start.extend_from_slice(start);
+        body.end.clear();
+        body.end.extend_from_slice(end);
+        body.vel.clear();
+        let inv_dt = if dt > 0.0 { 1.0 / dt } else { 0.0 };
+        body.vel
+            .extend(start.iter().zip(end).map(|(a, b)| (b - a) * inv_dt));
+        body.max_displacement = start
+            .iter()
+            .zip(end)
+            .map(|(a, b)| (b - a).norm())
+            .fold(0.0, f64::max);
+        // Swept boxes grown by the skin; the transfer queries with its reach as the radius.
+        body.broad
+            .update(start, end, triangles, self.params.thickness);
+        Ok(())
+    }
+
+    /// Remove the body (nothing collides with it afterwards).
+    pub fn clear_body(&mut self) {
+        self.body = None;
+    }
+
+    /// Whether any collision work is configured.
+    pub fn is_active(&self) -> bool {
+        self.body.is_some() || self.params.self_collision
+    }
+
+    /// The staged model's geometric stage (thesis §5.4, (75)): every free cloth node within
+    /// reach (the body's largest displacement this step plus the margin) of the body, on its
+    /// outside, takes on the change of the body's velocity at the nearest body point since the
+    /// previous step, so the cloth moves with the body and the physical stage sees a small
+    /// relative speed.
+    pub fn transfer(&mut self, positions: &[V3], velocities: &mut [V3], inverse_masses: &[f64]) {
+        if !self.params.staged {
+            return;
+        }
+        let Some(body) = self.body.as_ref() else {
+            return;
+        };
+        let reach = body.max_displacement + self.params.transfer_margin;
+        // Search a small ball first: most cloth near a body is within a centimetre of it, and a
+        // nearest point found inside the small ball is the nearest within the whole reach (any
+        // nearer triangle would have been a candidate too).
+        let near = reach.min(body.max_displacement + 0.01);
+        let mut transferred = 0;
+        for (i, p) in positions.iter().enumerate() {
+            if inverse_masses[i] == 0.0 {
+                continue;
+            }
+            let mut best: Option<(f64, usize, [f64; 3])> = None;
+            for radius in [near, reach] {
+                self.candidates.clear();
+                body.broad.query(p, p, radius, &mut self.candidates);
+                best = nearest_outside(body, p, &self.candidates, radius, self.params.thickness);
+                if best.is_some() || radius >= reach {
+                    break;
+                }
+            }
+            if let Some((_, t, w)) = best {
+                let tri = body.triangles[t];
+                let dv: V3 = (0..3)
+                    .map(|k| (body.vel[tri[k] as usize] - body.prev_vel[tri[k] as usize]) * w[k])
+                    .sum();
+                velocities[i] += dv;
+                transferred += 1;
+            }
+        }
+        self.stats.transferred += transferred;
+    }
+
+    /// One physical collision pass: every free node against the body's triangles (moving from
+    /// start to end) and, with self-collision, against the cloth's triangles that do not contain
+    /// it. Nodes are visited in index order; each takes its earliest contact.
+    pub fn resolve(&mut self, cloth: ClothView<'_>, dt: f64) {
+        if !self.is_active() || dt <= 0.0 {
+            return;
+        }
+        let ClothView {
+            positions,
+            velocities,
+            exit,
+            inverse_masses,
+            triangles,
+            normals,
+        } = cloth;
+        let n = positions.len();
+        let p = self.params;
+        let test = match p.narrow {
+            NarrowTest::Exact => point_triangle,
+            NarrowTest::Thesis => point_triangle_thesis,
+        };
+        if p.self_collision {
+            self.cloth_end.clear();
+            self.cloth_end
+                .extend((0..n).map(|i| positions[i] + velocities[i] * dt));
+            let broad = self.cloth_broad.get_or_insert_with(|| new_broad(p.broad));
+            broad.update(positions, &self.cloth_end, triangles, p.thickness);
+        }
+        for i in 0..n {
+            if inverse_masses[i] == 0.0 {
+                continue;
+            }
+            let (pi, vi) = (positions[i], velocities[i]);
+            let end = pi + vi * dt;
+            // Earliest contact: (hit, Some(triangle) for cloth, None for the body).
+            let mut best: Option<(Hit, usize, bool)> = None;
+            if let Some(body) = self.body.as_ref() {
+                self.candidates.clear();
+                body.broad
+                    .query(&pi, &end, p.thickness, &mut self.candidates);
+                self.stats.candidates += self.candidates.len();
+                for &t in &self.candidates {
+                    let tri = body.triangles[t as usize];
+                    let x = tri.map(|k| &body.start[k as usize]);
+                    let u = tri.map(|k| &body.vel[k as usize]);
+                    if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Front) {
+                        if p.one_sided && !normals.is_empty() && normals[i].dot(&hit.normal) <= 0.0
+                        {
+                            continue;
+                        }
+                        if best.is_none_or(|b| hit.time < b.0.time) {
+                            best = Some((hit, t as usize, false));
+                        }
+                    }
+                }
+            }
+            if p.self_collision
+                && let Some(broad) = self.cloth_broad.as_ref()
+            {
+                self.candidates.clear();
+                broad.query(&pi, &end, p.thickness, &mut self.candidates);
+                self.stats.candidates += self.candidates.len();
+                for &t in &self.candidates {
+                    let tri = triangles[t as usize];
+                    if tri.contains(&(i as u32)) {
+                        continue;
+                    }
+                    let x = tri.map(|k| &positions[k as usize]);
+                    let u = tri.map(|k| &velocities[k as usize]);
+                    if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Both)
+                        && best.is_none_or(|b| hit.time < b.0.time)
+                    {
+                        best = Some((hit, t as usize, true));
+                    }
+                }
+            }
+            let Some((hit, t, is_cloth)) = best else {
+                continue;
+            };
+            let (tri, inv_mu, u) = if is_cloth {
+                let tri = triangles[t];
+                (
+                    tri,
+                    tri.map(|k| inverse_masses[k as usize]),
+                    tri.map(|k| velocities[k as usize]),
+                )
+            } else {
+                let body = self.body.as_ref().expect("body hit");
+                let tri = body.triangles[t];
+                (tri, [0.0; 3], tri.map(|k| body.vel[k as usize]))
+            };
+            let Some(r) = respond(
+                &vi,
+                inverse_masses[i],
+                [&u[0], &u[1], &u[2]],
+                inv_mu,
+                hit.weights,
+                &hit.normal,
+                hit.time,
+                dt,
+                p.material,
+            ) else {
+                continue;
+            };
+            velocities[i] = r.mean;
+            exit[i] += r.exit - r.mean;
+            if is_cloth {
+                for k in 0..3 {
+                    velocities[tri[k] as usize] += r.vertex_dv[k];
+                }
+                self.stats.self_hits += 1;
+            } else {
+                self.stats.body_hits += 1;
+            }
+        }
+    }
+}
+
+/// The nearest point within `radius` of `p` among the `candidates` triangles of the body at the
+/// start of the step, with `p` on the outside (or within the skin): (distance, triangle,
+/// barycentric weights).
+fn nearest_outside(
+    body: &Body,
+    p: &V3,
+    candidates: &[u32],
+    radius: f64,
+    thickness: f64,
+) -> Option<(f64, usize, [f64; 3])> {
+    let mut best: Option<(f64, usize, [f64; 3])> = None;
+    for &t in candidates {
+        let tri = body.triangles[t as usize];
+        let x = tri.map(|k| &body.start[k as usize]);
+        let (q, w) = closest_point(p, x);
+        let dist = (p - q).norm();
+        if dist > radius || best.is_some_and(|b| dist >= b.0) {
+            continue;
+        }
+        // Outside (or on) the body: the outward normal faces the node.
+        let n = (x[1] - x[0]).cross(&(x[2] - x[0]));
+        if (p - q).dot(&n) < -thickness * n.norm() {
+            continue;
+        }
+        best = Some((dist, t as usize, w));
+    }
+    best
+}
+
+/// The point of triangle `x` nearest to `p`, with its barycentric weights (Ericson, Real-Time
+/// Collision Detection §5.1.5).
+pub fn closest_point(p: &V3, x: [&V3; 3]) -> (V3, [f64; 3]) {
+    let (a, b, c) = (x[0], x[1], x[2]);
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (*a, [1.0, 0.0, 0.0]);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (*b, [0.0, 1.0, 0.0]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + ab * v, [1.0 - v, v, 0.0]);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (*c, [0.0, 0.0, 1.0]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + ac * w, [1.0 - w, 0.0, w]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + (c - b) * w, [0.0, 1.0 - w, w]);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (a + ab * v + ac * w, [1.0 - v - w, v, w])
+}

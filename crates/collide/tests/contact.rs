@@ -1,0 +1,259 @@
+//! The collision model against reference values: Coulomb friction on a slope, restitution in a
+//! bounce, no tunnelling for fast particles, and the one-sided rule.
+
+use atelier_collide::broad::BroadKind;
+use atelier_collide::{ClothView, Collider, ContactMaterial, ContactParams, V3};
+use proptest::prelude::*;
+
+const G: f64 = 9.80665;
+
+/// A particle under gravity colliding with a static body, stepped by symplectic Euler with the
+/// collider's mean and exit velocities.
+struct Particle {
+    p: V3,
+    v: V3,
+    normal: V3,
+}
+
+fn step(c: &mut Collider, part: &mut Particle, dt: f64) {
+    part.v += V3::new(0.0, 0.0, -G) * dt;
+    let mut vel = [part.v];
+    let mut exit = [V3::zeros()];
+    c.resolve(
+        ClothView {
+            positions: &[part.p],
+            velocities: &mut vel,
+            exit: &mut exit,
+            inverse_masses: &[1.0],
+            triangles: &[],
+            normals: &[part.normal],
+        },
+        dt,
+    );
+    part.p += vel[0] * dt;
+    part.v = vel[0] + exit[0];
+}
+
+fn params(restitution: f64, friction: f64, broad: BroadKind) -> ContactParams {
+    ContactParams {
+        material: ContactMaterial {
+            restitution,
+            friction,
+        },
+        thickness: 1e-4,
+        staged: false,
+        broad,
+        ..ContactParams::default()
+    }
+}
+
+/// A square plane 4 m wide through the origin, tilted by `alpha` about the x axis (two
+/// counter-clockwise triangles, normal up the slope's outside).
+fn slope(alpha: f64) -> (Vec<V3>, Vec<[u32; 3]>) {
+    let (c, s) = (alpha.cos(), alpha.sin());
+    let corner = |x: f64, y: f64| V3::new(x, y * c, y * s);
+    (
+        vec![
+            corner(-2.0, -2.0),
+            corner(2.0, -2.0),
+            corner(2.0, 2.0),
+            corner(-2.0, 2.0),
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+}
+
+#[test]
+fn a_particle_on_a_slope_sticks_below_the_friction_angle_and_slides_above() {
+    let dt = 1e-3;
+    for rho in [0.2f64, 0.5, 0.9] {
+        for (alpha, slides) in [(rho.atan() * 0.9, false), (rho.atan() * 1.1, true)] {
+            let (v, t) = slope(alpha);
+            let mut c = Collider::new(params(0.0, rho, BroadKind::Bvh)).expect("params");
+            c.set_body(&v, &v, &t, dt).expect("body");
+            let normal = V3::new(0.0, -alpha.sin(), alpha.cos());
+            let mut part = Particle {
+                p: V3::zeros(),
+                v: V3::zeros(),
+                normal,
+            };
+            let steps = 1000;
+            for _ in 0..steps {
+                step(&mut c, &mut part, dt);
+            }
+            let along = -part.p.dot(&V3::new(0.0, alpha.cos(), alpha.sin()));
+            let off = part.p.dot(&normal);
+            assert!(
+                off.abs() < 1e-6,
+                "ρ {rho} α {alpha}: left the slope by {off}"
+            );
+            if slides {
+                // Coulomb: a = g (sin α − ρ cos α), s = a t²/2 (discrete sum: a dt² n(n+1)/2).
+                let a = G * (alpha.sin() - rho * alpha.cos());
+                let expect = a * dt * dt * (steps * (steps + 1)) as f64 / 2.0;
+                assert!(
+                    (along - expect).abs() < 0.02 * expect,
+                    "ρ {rho}: slid {along} m, Coulomb {expect} m"
+                );
+            } else {
+                assert!(
+                    along.abs() < 1e-12,
+                    "ρ {rho}: crept {along} m below the friction angle"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_bounce_rises_to_restitution_squared_of_the_drop() {
+    for (nu, broad) in [(0.5, BroadKind::Bvh), (0.8, BroadKind::Projection)] {
+        let (v, t) = slope(0.0);
+        let dt = 1e-5;
+        let mut c = Collider::new(params(nu, 0.0, broad)).expect("params");
+        c.set_body(&v, &v, &t, dt).expect("body");
+        let h = 0.5;
+        let mut part = Particle {
+            p: V3::new(0.3, 0.1, h),
+            v: V3::zeros(),
+            normal: V3::z(),
+        };
+        let (mut bounced, mut apex) = (false, 0.0f64);
+        for _ in 0..300_000 {
+            step(&mut c, &mut part, dt);
+            if part.v.z > 0.0 {
+                bounced = true;
+            }
+            if bounced {
+                apex = apex.max(part.p.z);
+                if part.v.z < 0.0 {
+                    break;
+                }
+            }
+        }
+        let ratio = apex / h;
+        assert!(
+            (ratio - nu * nu).abs() < 0.01 * nu * nu,
+            "ν {nu}: rose to {ratio} of the drop, expected {}",
+            nu * nu
+        );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+    /// Fast particles (up to 20 m/s at Δt 0.01 s) against triangles moving up to 5 m/s never end
+    /// a step on the far side of the triangle they crossed.
+    #[test]
+    fn no_tunnelling(
+        tri in prop::array::uniform3(prop::array::uniform3(-0.5f64..0.5)),
+        tri_v in prop::array::uniform3(-5.0f64..5.0),
+        start in prop::array::uniform3(-0.5f64..0.5),
+        vel in prop::array::uniform3(-20.0f64..20.0),
+        projection in any::<bool>(),
+    ) {
+        let dt = 0.01;
+        let x: Vec<V3> = tri.iter().map(|q| V3::new(q[0], q[1], q[2])).collect();
+        let n = (x[1] - x[0]).cross(&(x[2] - x[0]));
+        prop_assume!(n.norm() > 1e-3);
+        let n = n.normalize();
+        let u = V3::new(tri_v[0], tri_v[1], tri_v[2]);
+        let end: Vec<V3> = x.iter().map(|q| q + u * dt).collect();
+        let p = V3::new(start[0], start[1], start[2]);
+        let v = V3::new(vel[0], vel[1], vel[2]);
+        // Start in front of the triangle's plane by more than the skin.
+        prop_assume!((p - x[0]).dot(&n) > 1e-3);
+        let broad = if projection { BroadKind::Projection } else { BroadKind::Bvh };
+        let mut c = Collider::new(params(0.2, 0.4, broad)).expect("params");
+        c.set_body(&x, &end, &[[0, 1, 2]], dt).expect("body");
+        let mut vels = [v];
+        let mut exit = [V3::zeros()];
+        c.resolve(ClothView {
+            positions: &[p],
+            velocities: &mut vels,
+            exit: &mut exit,
+            inverse_masses: &[1.0],
+            triangles: &[],
+            normals: &[],
+        }, dt);
+        let q = p + vels[0] * dt;
+        // Relative to the triangle (it translates): the path p → q against the static triangle
+        // at the start must not cross it.
+        let q_rel = q - u * dt;
+        let (s0, s1) = ((p - x[0]).dot(&n), (q_rel - x[0]).dot(&n));
+        if s1 < -1e-9 {
+            // Crossed the plane: the crossing must lie outside the triangle.
+            let t = s0 / (s0 - s1);
+            let c = p + (q_rel - p) * t;
+            let w = atelier_collide::narrow::barycentric(&c, [&x[0], &x[1], &x[2]]);
+            prop_assert!(w.iter().any(|&k| k < -1e-9), "tunnelled: s {s0} → {s1}, at {w:?}");
+        }
+    }
+}
+
+#[test]
+fn one_sided_contact_lets_a_node_through_from_outside_and_catches_it_inside() {
+    // A body surface facing +z; nodes falling onto it from above.
+    let (v, t) = slope(0.0);
+    let dt = 0.01;
+    let one_sided = ContactParams {
+        one_sided: true,
+        ..params(0.0, 0.0, BroadKind::Bvh)
+    };
+    for (node_normal, caught) in [(V3::z(), true), (-V3::z(), false)] {
+        let mut c = Collider::new(one_sided).expect("params");
+        c.set_body(&v, &v, &t, dt).expect("body");
+        let mut part = Particle {
+            p: V3::new(0.0, 0.0, 0.05),
+            v: V3::new(0.0, 0.0, -2.0),
+            normal: node_normal,
+        };
+        for _ in 0..10 {
+            step(&mut c, &mut part, dt);
+        }
+        if caught {
+            assert!(part.p.z > -1e-9, "not caught: z = {}", part.p.z);
+        } else {
+            assert!(part.p.z < -0.1, "not let through: z = {}", part.p.z);
+        }
+    }
+}
+
+#[test]
+fn bad_contact_parameters_and_bodies_are_refused() {
+    let bad = ContactParams {
+        material: ContactMaterial {
+            restitution: 1.5,
+            friction: 0.3,
+        },
+        ..ContactParams::default()
+    };
+    assert!(Collider::new(bad).is_err());
+    let mut c = Collider::new(ContactParams::default()).expect("params");
+    let v = vec![V3::zeros(); 3];
+    assert!(c.set_body(&v, &v[..2], &[[0, 1, 2]], 0.01).is_err());
+    assert!(c.set_body(&v, &v, &[[0, 1, 3]], 0.01).is_err());
+    let nan = vec![V3::zeros(), V3::new(f64::NAN, 0.0, 0.0), V3::zeros()];
+    assert!(c.set_body(&nan, &nan, &[[0, 1, 2]], 0.01).is_err());
+}
+
+#[test]
+fn without_a_body_or_self_collision_nothing_is_built_or_done() {
+    let mut c = Collider::new(ContactParams::default()).expect("params");
+    assert!(!c.is_active());
+    let mut vel = [V3::new(0.0, 0.0, -1.0)];
+    let mut exit = [V3::zeros()];
+    c.resolve(
+        ClothView {
+            positions: &[V3::zeros()],
+            velocities: &mut vel,
+            exit: &mut exit,
+            inverse_masses: &[1.0],
+            triangles: &[],
+            normals: &[],
+        },
+        0.01,
+    );
+    assert_eq!(c.take_stats().candidates, 0);
+    assert_eq!(vel[0], V3::new(0.0, 0.0, -1.0));
+}

@@ -1,0 +1,90 @@
+//! The collision hook the step calls: [`atelier_collide::Collider`] adapted to a [`Cloth`] — its
+//! triangles for self-collision, its node normals for one-sided contact, its inverse masses.
+
+use atelier_collide::{ClothView, Collider, ContactError, ContactParams, PassStats, V3};
+
+use crate::cloth::Cloth;
+use crate::step::{CollisionHook, HookContext};
+
+/// Collisions of one cloth with a body (moving or not) and with itself.
+pub struct BodyContact {
+    collider: Collider,
+    triangles: Vec<[u32; 3]>,
+    normals: Vec<V3>,
+}
+
+impl BodyContact {
+    /// A hook for `cloth` with checked contact parameters; no body until
+    /// [`BodyContact::set_body`].
+    pub fn new(cloth: &Cloth, params: ContactParams) -> Result<Self, ContactError> {
+        Ok(Self {
+            collider: Collider::new(params)?,
+            triangles: cloth.topology().triangles().to_vec(),
+            normals: Vec::new(),
+        })
+    }
+
+    /// The body over the coming step (vertices at its start and end, outward triangles).
+    pub fn set_body(
+        &mut self,
+        start: &[V3],
+        end: &[V3],
+        triangles: &[[u32; 3]],
+        dt: f64,
+    ) -> Result<(), ContactError> {
+        self.collider.set_body(start, end, triangles, dt)
+    }
+
+    /// Counts since the last call.
+    pub fn take_stats(&mut self) -> PassStats {
+        self.collider.take_stats()
+    }
+
+    /// Area-weighted node normals of the cloth at `positions` (for one-sided contact).
+    fn update_normals(&mut self, positions: &[V3]) {
+        self.normals.clear();
+        self.normals.resize(positions.len(), V3::zeros());
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|k| positions[k as usize]);
+            let n = (b - a).cross(&(c - a));
+            for &k in t {
+                self.normals[k as usize] += n;
+            }
+        }
+        for n in &mut self.normals {
+            let len = n.norm();
+            if len > 0.0 {
+                *n /= len;
+            }
+        }
+    }
+}
+
+impl CollisionHook for BodyContact {
+    fn transfer(&mut self, ctx: HookContext<'_>) {
+        self.collider
+            .transfer(ctx.positions, ctx.velocities, ctx.inverse_masses);
+    }
+
+    fn resolve(&mut self, ctx: HookContext<'_>) {
+        if !self.collider.is_active() {
+            return;
+        }
+        if self.collider.params().one_sided {
+            self.update_normals(ctx.positions);
+        } else {
+            self.normals.clear();
+        }
+        self.collider.resolve(
+            ClothView {
+                positions: ctx.positions,
+                velocities: ctx.velocities,
+                exit: ctx.exit,
+                inverse_masses: ctx.inverse_masses,
+                triangles: &self.triangles,
+                normals: &self.normals,
+            },
+            ctx.dt,
+        );
+    }
+}
