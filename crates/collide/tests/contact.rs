@@ -257,3 +257,54 @@ fn without_a_body_or_self_collision_nothing_is_built_or_done() {
     assert_eq!(c.take_stats().candidates, 0);
     assert_eq!(vel[0], V3::new(0.0, 0.0, -1.0));
 }
+
+#[test]
+fn self_collision_stops_a_node_at_a_cloth_triangle_and_conserves_momentum() {
+    // Cloth: a triangle (nodes 0–2) at rest at z = 0 and a loose node 3 falling onto it; masses
+    // differ. The triangle's own nodes never collide with it.
+    let x = [
+        V3::new(0.0, 0.0, 0.0),
+        V3::new(0.2, 0.0, 0.0),
+        V3::new(0.0, 0.2, 0.0),
+        V3::new(0.05, 0.05, 0.03),
+    ];
+    let masses = [0.002, 0.003, 0.0025, 0.001];
+    let inv: Vec<f64> = masses.iter().map(|m| 1.0 / m).collect();
+    let mut vel = [
+        V3::zeros(),
+        V3::zeros(),
+        V3::zeros(),
+        V3::new(0.3, 0.0, -6.0),
+    ];
+    let mut exit = [V3::zeros(); 4];
+    let before: V3 = vel.iter().zip(&masses).map(|(v, m)| v * *m).sum();
+    let params = ContactParams {
+        self_collision: true,
+        ..params(0.2, 0.3, BroadKind::Bvh)
+    };
+    let mut c = Collider::new(params).expect("params");
+    let dt = 0.01;
+    c.resolve(
+        ClothView {
+            positions: &x,
+            velocities: &mut vel,
+            exit: &mut exit,
+            inverse_masses: &inv,
+            triangles: &[[0, 1, 2]],
+            normals: &[],
+        },
+        dt,
+    );
+    let stats = c.take_stats();
+    assert_eq!(stats.self_hits, 1, "{stats:?}");
+    let exit_v: Vec<V3> = vel.iter().zip(&exit).map(|(v, e)| v + e).collect();
+    let after: V3 = exit_v.iter().zip(&masses).map(|(v, m)| v * *m).sum();
+    assert!(
+        (after - before).norm() <= 1e-12 * before.norm(),
+        "{before} → {after}"
+    );
+    // The node ends the step above the (moving) triangle's plane.
+    let end: Vec<V3> = (0..4).map(|k| x[k] + vel[k] * dt).collect();
+    let n = (end[1] - end[0]).cross(&(end[2] - end[0])).normalize();
+    assert!((end[3] - end[0]).dot(&n) >= -1e-12);
+}
