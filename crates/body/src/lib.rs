@@ -1,0 +1,12 @@
+//! # atelier-body
+//!
+//! The human body of the PARTY thesis (§2.4 (II), §4.6.2, §5.6): a surface of triangles split
+//! into 17 rigid parts in a tree with movable joints, driven by keyframed motion.
+
+pub mod build;
+pub mod description;
+pub mod io;
+pub mod model;
+pub mod range;
+
+pub use model::{JointLimits, LabelledMesh, Mannequin, Part, PartMesh, V3};
