@@ -6,7 +6,13 @@
 pub mod build;
 pub mod description;
 pub mod io;
+pub mod kinematics;
 pub mod model;
+pub mod motion;
 pub mod range;
+#[cfg(test)]
+mod testing;
 
+pub use kinematics::{Body, PartFrame, Posed, bounding_box};
 pub use model::{JointLimits, LabelledMesh, Mannequin, Part, PartMesh, V3};
+pub use motion::{LimitPolicy, Motion, MotionError, MotionSpec, Pose, PoseRate};

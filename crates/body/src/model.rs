@@ -11,9 +11,14 @@ pub use atelier_grid::range::Part;
 /// 3-vector, m.
 pub type V3 = nalgebra::Vector3<f64>;
 
-/// Rotation limits of a joint, degrees, about the joint's own axes in the parent's rest frame:
-/// x (flexion, positive bends forward for hips and shoulders), y (axial rotation, positive turns
-/// towards the body's left), z (abduction, positive lifts towards the body's left).
+/// Rotation limits of a joint, degrees. A joint's rotation is given by three angles: right-handed
+/// rotations about the x, y and z axes of the parent's rest frame (x = the body's left, y = up,
+/// z = forward), applied x first: `R = R_z(γ) · R_y(β) · R_x(α)`. With these signs a downward
+/// segment swings **backward** for positive α: hip and shoulder flexion (forward) are negative,
+/// knee flexion (shin back) positive, elbow flexion (forearm forward) negative, ankle
+/// dorsiflexion (toes up) negative, neck flexion (head forward) positive; β > 0 turns the part
+/// towards the body's left seen from above; γ > 0 swings a downward segment towards the body's
+/// left (so abduction is positive γ for the left limbs and negative for the right).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointLimits {
     /// Smallest angles about x, y, z.
@@ -81,7 +86,8 @@ impl Mannequin {
         for p in &self.parts {
             let base = m.vertices.len() as u32;
             m.vertices.extend_from_slice(&p.vertices);
-            m.vertex_part.extend(std::iter::repeat_n(p.part, p.vertices.len()));
+            m.vertex_part
+                .extend(std::iter::repeat_n(p.part, p.vertices.len()));
             m.triangles
                 .extend(p.triangles.iter().map(|t| t.map(|k| k + base)));
             m.triangle_part
