@@ -8,11 +8,12 @@
 //!   improvement, energy, quality histograms, the dress panels with seams, the body from range
 //!   images coloured by part and its error image.
 
-mod figures_body;
 mod figures_fabric;
 mod figures_grid;
+mod figures_grid_body;
 mod figures_solver;
 mod plot;
+mod render;
 
 use std::path::{Path, PathBuf};
 

@@ -1,0 +1,165 @@
+//! A small orthographic z-buffer renderer for the figures (no maintained software-rasteriser
+//! crate fits, see `dependencies.md`): flat-shaded triangles coloured per triangle, seen from
+//! the front, the back or the body's left side, scaled to fit a box.
+
+use plotters::prelude::RGBColor;
+
+/// Which way the camera looks (frame: x = the body's left, y up, z forward).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum View {
+    /// From the front, looking along −z (the body's left on the viewer's right).
+    Front,
+    /// From behind, looking along +z.
+    Back,
+    /// From the body's left, looking along −x (the body's front on the viewer's left).
+    Left,
+}
+
+/// The fitting of a scene into an image: pixels per metre and the centre.
+#[derive(Clone, Copy, Debug)]
+pub struct Fit {
+    scale: f64,
+    centre: [f64; 2],
+}
+
+impl Fit {
+    /// Fit the given screen-plane box (`lo`, `hi` in view coordinates) into `w × h` with a margin.
+    pub fn new(lo: [f64; 2], hi: [f64; 2], w: usize, h: usize) -> Self {
+        let scale = (0.94 * w as f64 / (hi[0] - lo[0]).max(1e-9))
+            .min(0.94 * h as f64 / (hi[1] - lo[1]).max(1e-9));
+        Self {
+            scale,
+            centre: [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])],
+        }
+    }
+}
+
+/// View coordinates of a point: (screen x to the right, screen y up, depth towards the camera).
+pub fn to_view(p: [f64; 3], view: View) -> [f64; 3] {
+    match view {
+        View::Front => [p[0], p[1], p[2]],
+        View::Back => [-p[0], p[1], -p[2]],
+        View::Left => [-p[2], p[1], p[0]],
+    }
+}
+
+/// The screen-plane box of points seen from `view`.
+pub fn screen_box(points: &[[f64; 3]], view: View) -> ([f64; 2], [f64; 2]) {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in points {
+        let q = to_view(*p, view);
+        for k in 0..2 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    (lo, hi)
+}
+
+/// Render: RGB per pixel (`None` = background), `w × h`, row 0 at the top.
+pub fn render(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    colour: &dyn Fn(usize) -> [f64; 3],
+    view: View,
+    fit: Fit,
+    w: usize,
+    h: usize,
+) -> Vec<Option<[f64; 3]>> {
+    let project = |p: [f64; 3]| -> [f64; 3] {
+        let q = to_view(p, view);
+        [
+            0.5 * w as f64 + (q[0] - fit.centre[0]) * fit.scale,
+            0.5 * h as f64 - (q[1] - fit.centre[1]) * fit.scale,
+            q[2],
+        ]
+    };
+    let mut depth = vec![f64::NEG_INFINITY; w * h];
+    let mut out = vec![None; w * h];
+    for (ti, t) in triangles.iter().enumerate() {
+        let [a, b, c] = t.map(|k| to_view(positions[k as usize], view));
+        let n = cross(sub(b, a), sub(c, a));
+        let len = dot(n, n).sqrt();
+        if len == 0.0 || n[2] <= 0.0 {
+            continue;
+        }
+        let shade = 0.25 + 0.75 * n[2] / len;
+        let rgb = colour(ti).map(|v| v * shade);
+        let [pa, pb, pc] = t.map(|k| project(positions[k as usize]));
+        let x0 = pa[0].min(pb[0]).min(pc[0]).floor().max(0.0) as usize;
+        let x1 = (pa[0].max(pb[0]).max(pc[0]).ceil().max(0.0) as usize).min(w - 1);
+        let y0 = pa[1].min(pb[1]).min(pc[1]).floor().max(0.0) as usize;
+        let y1 = (pa[1].max(pb[1]).max(pc[1]).ceil().max(0.0) as usize).min(h - 1);
+        let area = edge(pa, pb, pc);
+        if area.abs() < 1e-12 {
+            continue;
+        }
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let q = [x as f64 + 0.5, y as f64 + 0.5, 0.0];
+                let l = [
+                    edge(pb, pc, q) / area,
+                    edge(pc, pa, q) / area,
+                    edge(pa, pb, q) / area,
+                ];
+                if l.iter().any(|&v| v < 0.0) {
+                    continue;
+                }
+                let z = l[0] * pa[2] + l[1] * pb[2] + l[2] * pc[2];
+                let k = y * w + x;
+                if z > depth[k] {
+                    depth[k] = z;
+                    out[k] = Some(rgb);
+                }
+            }
+        }
+    }
+    out
+}
+
+fn edge(a: [f64; 3], b: [f64; 3], p: [f64; 3]) -> f64 {
+    (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// An RGB colour from components in [0, 1].
+pub fn to_rgb(c: [f64; 3]) -> RGBColor {
+    let q = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    RGBColor(q(c[0]), q(c[1]), q(c[2]))
+}
+
+/// One colour per body part index (hues spread by the golden ratio).
+pub fn part_colour(index: usize) -> [f64; 3] {
+    let hue = (index as f64 * 0.618_034).fract();
+    hsv(hue, 0.55, 0.95)
+}
+
+fn hsv(h: f64, s: f64, v: f64) -> [f64; 3] {
+    let i = (h * 6.0).floor();
+    let f = h * 6.0 - i;
+    let (p, q, t) = (v * (1.0 - s), v * (1.0 - f * s), v * (1.0 - (1.0 - f) * s));
+    match i as i32 % 6 {
+        0 => [v, t, p],
+        1 => [q, v, p],
+        2 => [p, v, t],
+        3 => [p, q, v],
+        4 => [t, p, v],
+        _ => [v, p, q],
+    }
+}
