@@ -7,7 +7,10 @@
 //! - `cargo xtask figures grid [--out DIR]` — the gridding figures: pattern grids before and after
 //!   improvement, energy, quality histograms, the dress panels with seams, the body from range
 //!   images coloured by part and its error image.
+//! - `cargo xtask figures body [--out DIR]` — the mannequin at rest and walking (front and side),
+//!   the arm raise, and its range images with landmarks.
 
+mod figures_body;
 mod figures_fabric;
 mod figures_grid;
 mod figures_grid_body;
@@ -48,6 +51,8 @@ enum FigureSet {
     /// Pattern grids before and after improvement, quality histograms, the dress panels, the
     /// body from range images.
     Grid,
+    /// The mannequin at rest, walking and raising its arms; its range images.
+    Body,
 }
 
 /// A figure set's entry point: draw everything from the repository root into a folder, return
@@ -66,6 +71,7 @@ fn main() -> Result<()> {
                 FigureSet::Fabric => ("fabric", figures_fabric::draw_all),
                 FigureSet::Solver => ("solver", figures_solver::draw_all),
                 FigureSet::Grid => ("grid", figures_grid::draw_all),
+                FigureSet::Body => ("body", figures_body::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;

@@ -160,7 +160,10 @@ mod tests {
     use proptest::prelude::*;
     use std::collections::BTreeMap;
 
-    fn spec(frames: &[(f64, (f64, f64, f64), &[(&str, (f64, f64, f64))])]) -> MotionSpec {
+    /// (time, root cm, joint angles by name).
+    type Frame<'a> = (f64, (f64, f64, f64), &'a [(&'a str, (f64, f64, f64))]);
+
+    fn spec(frames: &[Frame<'_>]) -> MotionSpec {
         MotionSpec {
             name: "test".into(),
             provenance: "test".into(),

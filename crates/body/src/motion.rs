@@ -317,7 +317,7 @@ impl Motion {
         let s = (t - t0) / h;
         let mut pose = Pose::rest();
         let mut omega = [V3::zeros(); 17];
-        for j in 0..17 {
+        for (j, w) in omega.iter_mut().enumerate() {
             let (q0, q1) = (self.rotations[k][j], self.rotations[k + 1][j]);
             // q(s) = q0 · Δ^s, Δ = q0⁻¹ q1 on the short arc; the body-frame rate is θ·axis/h.
             let mut delta = q0.inverse() * q1;
@@ -327,7 +327,7 @@ impl Motion {
             let q = match delta.axis_angle() {
                 Some((axis, angle)) => {
                     let qs = q0 * UnitQuaternion::from_axis_angle(&axis, s * angle);
-                    omega[j] = qs * (axis.into_inner() * (angle / h));
+                    *w = qs * (axis.into_inner() * (angle / h));
                     qs
                 }
                 None => q0,

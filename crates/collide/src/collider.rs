@@ -30,6 +30,11 @@ pub struct ContactParams {
     pub broad: BroadKind,
     /// Narrow-phase test (exact by default; the thesis's linear test to reproduce it).
     pub narrow: NarrowTest,
+    /// A node found behind a body triangle (over its face, less than this deep, m) with no
+    /// contact in the pass is moved out within the step (addition: the thesis has no recovery;
+    /// a node squeezed into a crease between two moving parts otherwise stays inside). 0 turns
+    /// it off; keep it below half the thinnest body part.
+    pub recovery_depth: f64,
 }
 
 impl Default for ContactParams {
@@ -46,6 +51,7 @@ impl Default for ContactParams {
             transfer_margin: 0.07,
             broad: BroadKind::Bvh,
             narrow: NarrowTest::Exact,
+            recovery_depth: 5e-3,
         }
     }
 }
@@ -155,6 +161,8 @@ pub struct PassStats {
     pub self_hits: usize,
     /// Nodes the geometric transfer moved with the body.
     pub transferred: usize,
+    /// Nodes found inside the body (shallower than the recovery depth) and moved out.
+    pub recovered: usize,
 }
 
 struct Body {
@@ -358,90 +366,153 @@ impl Collider {
             if inverse_masses[i] == 0.0 {
                 continue;
             }
-            let (pi, vi) = (positions[i], velocities[i]);
-            let end = pi + vi * dt;
-            // Earliest contact: (hit, Some(triangle) for cloth, None for the body).
-            let mut best: Option<(Hit, usize, bool)> = None;
-            if let Some(body) = self.body.as_ref() {
-                self.candidates.clear();
-                body.broad
-                    .query(&pi, &end, p.thickness, &mut self.candidates);
-                self.stats.candidates += self.candidates.len();
-                for &t in &self.candidates {
-                    let tri = body.triangles[t as usize];
-                    let x = tri.map(|k| &body.start[k as usize]);
-                    let u = tri.map(|k| &body.vel[k as usize]);
-                    if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Front) {
-                        if p.one_sided && !normals.is_empty() && normals[i].dot(&hit.normal) <= 0.0
-                        {
+            // Up to MAX_CONTACTS contacts per node and pass, each against a surface not met yet
+            // (a node in a crease between two parts meets both).
+            let mut met: [(usize, bool); MAX_CONTACTS] = [(usize::MAX, false); MAX_CONTACTS];
+            for round in 0..MAX_CONTACTS {
+                let (pi, vi) = (positions[i], velocities[i]);
+                let end = pi + vi * dt;
+                // Earliest contact: (hit, Some(triangle) for cloth, None for the body).
+                let mut best: Option<(Hit, usize, bool)> = None;
+                if let Some(body) = self.body.as_ref() {
+                    self.candidates.clear();
+                    body.broad
+                        .query(&pi, &end, p.thickness, &mut self.candidates);
+                    self.stats.candidates += self.candidates.len();
+                    for &t in &self.candidates {
+                        let tri = body.triangles[t as usize];
+                        let x = tri.map(|k| &body.start[k as usize]);
+                        let u = tri.map(|k| &body.vel[k as usize]);
+                        if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Front) {
+                            if p.one_sided
+                                && !normals.is_empty()
+                                && normals[i].dot(&hit.normal) <= 0.0
+                            {
+                                continue;
+                            }
+                            if best.is_none_or(|b| hit.time < b.0.time)
+                                && !met[..round].contains(&(t as usize, false))
+                            {
+                                best = Some((hit, t as usize, false));
+                            }
+                        }
+                    }
+                }
+                if p.self_collision
+                    && let Some(broad) = self.cloth_broad.as_ref()
+                {
+                    self.candidates.clear();
+                    broad.query(&pi, &end, p.thickness, &mut self.candidates);
+                    self.stats.candidates += self.candidates.len();
+                    for &t in &self.candidates {
+                        let tri = triangles[t as usize];
+                        if tri.contains(&(i as u32)) {
                             continue;
                         }
-                        if best.is_none_or(|b| hit.time < b.0.time) {
-                            best = Some((hit, t as usize, false));
+                        let x = tri.map(|k| &positions[k as usize]);
+                        let u = tri.map(|k| &velocities[k as usize]);
+                        if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Both)
+                            && best.is_none_or(|b| hit.time < b.0.time)
+                            && !met[..round].contains(&(t as usize, true))
+                        {
+                            best = Some((hit, t as usize, true));
                         }
                     }
                 }
-            }
-            if p.self_collision
-                && let Some(broad) = self.cloth_broad.as_ref()
-            {
-                self.candidates.clear();
-                broad.query(&pi, &end, p.thickness, &mut self.candidates);
-                self.stats.candidates += self.candidates.len();
-                for &t in &self.candidates {
-                    let tri = triangles[t as usize];
-                    if tri.contains(&(i as u32)) {
-                        continue;
-                    }
-                    let x = tri.map(|k| &positions[k as usize]);
-                    let u = tri.map(|k| &velocities[k as usize]);
-                    if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Both)
-                        && best.is_none_or(|b| hit.time < b.0.time)
+                let Some((hit, t, is_cloth)) = best else {
+                    if round == 0
+                        && p.recovery_depth > p.thickness
+                        && let Some(body) = self.body.as_ref()
+                        && let Some(dv) = recover(body, &pi, &vi, dt, p, &mut self.candidates)
                     {
-                        best = Some((hit, t as usize, true));
+                        velocities[i] += dv;
+                        self.stats.recovered += 1;
                     }
+                    break;
+                };
+                met[round] = (t, is_cloth);
+                let (tri, inv_mu, u) = if is_cloth {
+                    let tri = triangles[t];
+                    (
+                        tri,
+                        tri.map(|k| inverse_masses[k as usize]),
+                        tri.map(|k| velocities[k as usize]),
+                    )
+                } else {
+                    let body = self.body.as_ref().expect("body hit");
+                    let tri = body.triangles[t];
+                    (tri, [0.0; 3], tri.map(|k| body.vel[k as usize]))
+                };
+                let Some(r) = respond(
+                    &vi,
+                    inverse_masses[i],
+                    [&u[0], &u[1], &u[2]],
+                    inv_mu,
+                    hit.weights,
+                    &hit.normal,
+                    hit.time,
+                    dt,
+                    p.material,
+                ) else {
+                    break;
+                };
+                velocities[i] = r.mean;
+                exit[i] += r.exit - r.mean;
+                if is_cloth {
+                    for k in 0..3 {
+                        velocities[tri[k] as usize] += r.vertex_dv[k];
+                    }
+                    self.stats.self_hits += 1;
+                } else {
+                    self.stats.body_hits += 1;
                 }
-            }
-            let Some((hit, t, is_cloth)) = best else {
-                continue;
-            };
-            let (tri, inv_mu, u) = if is_cloth {
-                let tri = triangles[t];
-                (
-                    tri,
-                    tri.map(|k| inverse_masses[k as usize]),
-                    tri.map(|k| velocities[k as usize]),
-                )
-            } else {
-                let body = self.body.as_ref().expect("body hit");
-                let tri = body.triangles[t];
-                (tri, [0.0; 3], tri.map(|k| body.vel[k as usize]))
-            };
-            let Some(r) = respond(
-                &vi,
-                inverse_masses[i],
-                [&u[0], &u[1], &u[2]],
-                inv_mu,
-                hit.weights,
-                &hit.normal,
-                hit.time,
-                dt,
-                p.material,
-            ) else {
-                continue;
-            };
-            velocities[i] = r.mean;
-            exit[i] += r.exit - r.mean;
-            if is_cloth {
-                for k in 0..3 {
-                    velocities[tri[k] as usize] += r.vertex_dv[k];
-                }
-                self.stats.self_hits += 1;
-            } else {
-                self.stats.body_hits += 1;
             }
         }
     }
+}
+
+/// Contacts a node may take in one pass (each against a different triangle).
+const MAX_CONTACTS: usize = 3;
+
+/// The velocity change that takes a node found behind a body triangle — over its face, less than
+/// the recovery depth deep — back to the surface within the step (relative to the triangle's
+/// motion): the shallowest such triangle decides.
+fn recover(
+    body: &Body,
+    p: &V3,
+    v: &V3,
+    dt: f64,
+    params: ContactParams,
+    candidates: &mut Vec<u32>,
+) -> Option<V3> {
+    candidates.clear();
+    body.broad.query(p, p, params.recovery_depth, candidates);
+    let mut best: Option<(f64, V3, V3)> = None;
+    for &t in candidates.iter() {
+        let tri = body.triangles[t as usize];
+        let x = tri.map(|k| &body.start[k as usize]);
+        let n = (x[1] - x[0]).cross(&(x[2] - x[0]));
+        let len = n.norm();
+        if len <= 0.0 {
+            continue;
+        }
+        let n = n / len;
+        let depth = -(p - x[0]).dot(&n);
+        if depth <= params.thickness || depth > params.recovery_depth {
+            continue;
+        }
+        let w = crate::narrow::barycentric(p, x);
+        if w.iter().any(|&c| c < 0.0) || best.is_some_and(|b| depth >= b.0) {
+            continue;
+        }
+        let u: V3 = (0..3).map(|k| body.vel[tri[k] as usize] * w[k]).sum();
+        best = Some((depth, n, u));
+    }
+    let (depth, n, u) = best?;
+    // Leave the step on the surface: relative normal speed at least depth/dt outwards.
+    let need = depth / dt;
+    let have = (v - u).dot(&n);
+    (have < need).then(|| n * (need - have))
 }
 
 /// The nearest point within `radius` of `p` among the `candidates` triangles of the body at the

@@ -308,3 +308,37 @@ fn self_collision_stops_a_node_at_a_cloth_triangle_and_conserves_momentum() {
     let n = (end[1] - end[0]).cross(&(end[2] - end[0])).normalize();
     assert!((end[3] - end[0]).dot(&n) >= -1e-12);
 }
+
+#[test]
+fn a_node_slightly_inside_the_body_is_moved_out_within_the_step() {
+    let (v, t) = slope(0.0);
+    let dt = 0.01;
+    for (depth, recovered) in [(0.003, true), (0.02, false)] {
+        let mut c = Collider::new(params(0.0, 0.0, BroadKind::Bvh)).expect("params");
+        c.set_body(&v, &v, &t, dt).expect("body");
+        let p = V3::new(0.1, 0.2, -depth);
+        let mut vel = [V3::zeros()];
+        let mut exit = [V3::zeros()];
+        c.resolve(
+            ClothView {
+                positions: &[p],
+                velocities: &mut vel,
+                exit: &mut exit,
+                inverse_masses: &[1.0],
+                triangles: &[],
+                normals: &[],
+            },
+            dt,
+        );
+        let end = p + vel[0] * dt;
+        if recovered {
+            assert!(end.z.abs() < 1e-12, "ends at {}", end.z);
+            assert_eq!(c.take_stats().recovered, 1);
+        } else {
+            assert!(
+                (end.z + depth).abs() < 1e-15,
+                "deeper than the recovery depth: left alone"
+            );
+        }
+    }
+}

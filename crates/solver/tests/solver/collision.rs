@@ -64,3 +64,203 @@ fn leg_measurements() {
         }
     }
 }
+
+/// A straight tube skirt (cotton, radius 17 cm, from 90 cm down to 40 cm above the floor, its
+/// waist row held) on the 9AR mannequin walking in place (the walk fixture without its forward
+/// translation): `(contact parameters, Δt)` → (frames with a node more than 2 mm inside a body part,
+/// deepest mm, contacts).
+fn walking_skirt(
+    contact_params: ContactParams,
+    dt: f64,
+    duration: f64,
+) -> Result<(usize, usize, f64, usize), String> {
+    use atelier_body::{Body, Motion, MotionSpec};
+    use atelier_collide::V3;
+    use atelier_collide::distance::BodyDistance;
+    use atelier_grid::{ClothTopology, StructuredGrid};
+    use atelier_solver::{BodyContact, Cloth, ClothState, PinMotion, Solver, StepParams};
+    use std::f64::consts::PI;
+
+    let body = Body::new(atelier_body::build::jis_9ar());
+    let path = crate::common::root().join("fixtures/motions/walk.ron");
+    let mut spec: MotionSpec = atelier_fabric::files::load_ron(&path).expect("walk");
+    for k in &mut spec.keyframes {
+        k.root_cm.2 = 0.0; // walk in place
+    }
+    let motion = Motion::new(&spec, &body.mannequin).expect("within limits");
+    let (r, top, len, h) = (0.17, 0.9, 0.5, 0.025);
+    let nu = (2.0 * PI * r / h).round() as usize; // one cell short: a slit at the side
+    let nv = (len / h).round() as usize + 1;
+    let width = (nu - 1) as f64 * h;
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(nu, nv, width, len)).expect("grid");
+    let mut cloth = Cloth::new(
+        topo,
+        &fabric("cotton_broad"),
+        atelier_fabric::AnisotropyForm::PlateTheory,
+    )
+    .expect("cloth");
+    let gap = 2.0 * PI * r - width;
+    let place = move |[x, y]: [f64; 2]| {
+        let a = PI / 2.0 + 0.5 * gap / r + x / r;
+        V3::new(r * a.sin(), top - len + y, r * a.cos())
+    };
+    for i in 0..nu {
+        let node = ((nv - 1) * nu + i) as u32;
+        let p = place(cloth.topology().rest_positions()[node as usize]);
+        cloth.pin(node, p, PinMotion::Fixed).expect("pin");
+    }
+    let mut state = ClothState::placed(&cloth, place);
+    let mut contact = BodyContact::new(&cloth, contact_params).expect("contact");
+    let tris = body.rest.triangles.clone();
+    let parts: Vec<(std::ops::Range<usize>, Vec<[u32; 3]>)> = {
+        let mut out = Vec::new();
+        let mut start = 0;
+        for p in &body.mannequin.parts {
+            out.push((start..start + p.vertices.len(), p.triangles.clone()));
+            start += p.vertices.len();
+        }
+        out
+    };
+    let mut distance: Vec<BodyDistance> = parts
+        .iter()
+        .map(|(range, t)| BodyDistance::new(&body.rest.vertices[range.clone()], t).expect("closed"))
+        .collect();
+    let params = StepParams {
+        dt,
+        ..StepParams::default()
+    };
+    let mut solver = Solver::new();
+    let steps = (duration / dt).round() as usize;
+    let (mut frames, mut worst, mut deepest, mut contacts) = (0, 0, 0.0f64, 0);
+    for k in 0..steps {
+        let t = k as f64 * dt;
+        let (a, b) = (body.at(&motion, t), body.at(&motion, t + dt));
+        contact
+            .set_body(&a.positions, &b.positions, &tris, dt)
+            .expect("body");
+        solver
+            .step_with(&cloth, &mut state, &params, &mut contact)
+            .map_err(|e| format!("step {k}: {e}"))?;
+        contacts += contact.take_stats().body_hits;
+        let mut inside = vec![false; state.positions.len()];
+        for ((range, _), d) in parts.iter().zip(&mut distance) {
+            d.update(&b.positions[range.clone()]).expect("update");
+            for (i, p) in state.positions.iter().enumerate() {
+                let s = d.signed_distance(p);
+                if s < -2e-3 {
+                    inside[i] = true;
+                    deepest = deepest.max(-s);
+                }
+            }
+        }
+        let n = inside.iter().filter(|&&x| x).count();
+        if n > 0 {
+            frames += 1;
+            worst = worst.max(n);
+        }
+    }
+    Ok((frames, worst, deepest, contacts))
+}
+
+#[test]
+fn the_staged_model_keeps_a_skirt_out_of_the_walking_mannequin() {
+    let (frames, worst, deepest, contacts) =
+        walking_skirt(ContactParams::default(), 0.01, 3.0).expect("runs");
+    eprintln!(
+        "staged, dt 0.01: {frames} frames with nodes inside (up to {worst}, {:.1} mm), {contacts} contacts",
+        deepest * 1e3
+    );
+    assert!(
+        contacts > 100,
+        "the legs must reach the skirt: {contacts} contacts"
+    );
+    assert_eq!(
+        frames,
+        0,
+        "up to {worst} nodes inside, {:.1} mm deep",
+        deepest * 1e3
+    );
+}
+
+#[test]
+#[ignore = "a measurement for docs/validation.md: cargo test --release -- --ignored skirt_measurements --nocapture"]
+fn skirt_measurements() {
+    use atelier_collide::narrow::NarrowTest;
+    let base = ContactParams::default();
+    let cases = [
+        ("staged", ContactParams { ..base }, 0.01),
+        (
+            "staged, thesis narrow test",
+            ContactParams {
+                narrow: NarrowTest::Thesis,
+                ..base
+            },
+            0.01,
+        ),
+        (
+            "staged, no recovery",
+            ContactParams {
+                recovery_depth: 0.0,
+                ..base
+            },
+            0.01,
+        ),
+        (
+            "physical",
+            ContactParams {
+                staged: false,
+                ..base
+            },
+            0.01,
+        ),
+        (
+            "physical",
+            ContactParams {
+                staged: false,
+                ..base
+            },
+            0.005,
+        ),
+        (
+            "physical",
+            ContactParams {
+                staged: false,
+                ..base
+            },
+            0.002,
+        ),
+        (
+            "physical",
+            ContactParams {
+                staged: false,
+                ..base
+            },
+            0.001,
+        ),
+        (
+            "physical, thesis narrow test",
+            ContactParams {
+                staged: false,
+                narrow: NarrowTest::Thesis,
+                ..base
+            },
+            0.001,
+        ),
+    ];
+    for (name, params, dt) in cases {
+        let t0 = std::time::Instant::now();
+        match walking_skirt(params, dt, 3.0) {
+            Ok((frames, worst, deepest, contacts)) => eprintln!(
+                "| {name} | {dt} | {frames} of {} | {worst} | {:.1} | {contacts} | {:.1} |",
+                (3.0 / dt).round(),
+                deepest * 1e3,
+                t0.elapsed().as_secs_f64()
+            ),
+            Err(e) => eprintln!(
+                "| {name} | {dt} | stopped: {e} | | | | {:.1} |",
+                t0.elapsed().as_secs_f64()
+            ),
+        }
+    }
+}
