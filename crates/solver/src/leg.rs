@@ -100,7 +100,8 @@ fn rotate_x(p: &V3, theta: f64) -> V3 {
     V3::new(p.x, c * p.y - s * p.z, s * p.y + c * p.z)
 }
 
-/// Run the scene with `fabric`; the step parameters are the defaults with the scene's Δt.
+/// Run the scene with `fabric`; the step parameters are the defaults with the scene's Δt and
+/// gravity along −y.
 pub fn run_leg(scene: &LegScene, fabric: &Fabric) -> Result<LegRun, LegError> {
     let circumference = 2.0 * PI * scene.tube_radius;
     let nu = (circumference / scene.spacing).round() as usize; // one cell short: the gap
@@ -129,8 +130,10 @@ pub fn run_leg(scene: &LegScene, fabric: &Fabric) -> Result<LegRun, LegError> {
     let (leg, tris) = cylinder(scene.leg_radius, scene.leg_length, 24, 17);
     let mut contact = BodyContact::new(&cloth, scene.contact)?;
     let mut distance = BodyDistance::new(&leg, &tris)?;
+    // The body frame has y up (the solver's default gravity points along −z).
     let params = StepParams {
         dt: scene.dt,
+        gravity: [0.0, -atelier_fabric::STANDARD_GRAVITY, 0.0],
         ..StepParams::default()
     };
     let mut solver = Solver::new();

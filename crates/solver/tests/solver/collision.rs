@@ -126,8 +126,10 @@ fn walking_skirt(
         .iter()
         .map(|(range, t)| BodyDistance::new(&body.rest.vertices[range.clone()], t).expect("closed"))
         .collect();
+    // The body frame has y up (the solver's default gravity points along −z).
     let params = StepParams {
         dt,
+        gravity: [0.0, -atelier_fabric::STANDARD_GRAVITY, 0.0],
         ..StepParams::default()
     };
     let mut solver = Solver::new();
