@@ -470,6 +470,56 @@ impl ClothTopology {
         Ok(topo)
     }
 
+    /// Several topologies as one (a garment's panels in one cloth): nodes, edges, triangles and
+    /// cells concatenated in order, every index shifted by the parts before it; no edge joins two
+    /// parts (seams are pairs of nodes, sewn by the simulation). Returns the union and the first
+    /// node index of each part.
+    pub fn union(parts: &[&ClothTopology]) -> (ClothTopology, Vec<u32>) {
+        let mut topo = Self {
+            rest: Vec::new(),
+            edges: Vec::new(),
+            axial: Vec::new(),
+            axial_edge: Vec::new(),
+            triangles: Vec::new(),
+            node_area: Vec::new(),
+            incidence_offsets: Vec::new(),
+            incidence: Vec::new(),
+            tri_offsets: Vec::new(),
+            tri_incidence: Vec::new(),
+            cells: Vec::new(),
+            edge_cells: Vec::new(),
+            grid: None,
+        };
+        let mut offsets = Vec::with_capacity(parts.len());
+        for p in parts {
+            let (n0, e0) = (topo.rest.len() as u32, topo.edges.len() as u32);
+            offsets.push(n0);
+            let shift = |k: u32, by: u32| if k == NO_NODE { NO_NODE } else { k + by };
+            topo.rest.extend_from_slice(&p.rest);
+            topo.node_area.extend_from_slice(&p.node_area);
+            topo.edges.extend(p.edges.iter().map(|e| Edge {
+                a: e.a + n0,
+                b: e.b + n0,
+                ..*e
+            }));
+            topo.axial
+                .extend(p.axial.iter().map(|s| s.map(|k| shift(k, n0))));
+            topo.axial_edge
+                .extend(p.axial_edge.iter().map(|s| s.map(|k| shift(k, e0))));
+            topo.triangles
+                .extend(p.triangles.iter().map(|t| t.map(|k| k + n0)));
+            topo.cells.extend(p.cells.iter().map(|c| Cell {
+                nodes: c.nodes.map(|k| k + n0),
+                u_edges: c.u_edges.map(|k| k + e0),
+                v_edges: c.v_edges.map(|k| k + e0),
+                diagonals: c.diagonals.map(|k| k + e0),
+                ..*c
+            }));
+        }
+        topo.build_incidence();
+        (topo, offsets)
+    }
+
     /// CSR lists: for each node, the edges (and triangles) touching it; for each edge, its cells.
     fn build_incidence(&mut self) {
         let n = self.rest.len();
@@ -705,6 +755,34 @@ mod tests {
             assert_eq!([d.a, d.b], [c.nodes[0], c.nodes[2]]);
         }
         assert_eq!(t.incident_edges(8 + 7).len(), 8);
+    }
+
+    #[test]
+    fn a_union_keeps_every_part_intact() {
+        let a = ClothTopology::from_structured(&StructuredGrid::sheet(4, 3, 0.3, 0.2)).expect("a");
+        let b =
+            ClothTopology::from_structured(&StructuredGrid::annulus(12, 3, 0.1, 0.2)).expect("b");
+        let (u, offsets) = ClothTopology::union(&[&a, &b]);
+        assert_eq!(offsets, vec![0, 12]);
+        assert_eq!(u.node_count(), a.node_count() + b.node_count());
+        assert_eq!(u.edges().len(), a.edges().len() + b.edges().len());
+        assert_eq!(u.cells().len(), a.cells().len() + b.cells().len());
+        assert_relative_eq!(u.area(), a.area() + b.area(), max_relative = 1e-15);
+        // Part b's structure, shifted.
+        let (n0, e0) = (12u32, a.edges().len() as u32);
+        for (eu, eb) in u.edges()[e0 as usize..].iter().zip(b.edges()) {
+            assert_eq!((eu.a, eu.b), (eb.a + n0, eb.b + n0));
+            assert!((eu.rest_length - eb.rest_length).abs() < 1e-15);
+        }
+        for (k, s) in b.axial_neighbours().iter().enumerate() {
+            let su = u.axial_neighbours()[k + 12];
+            for j in 0..SLOTS {
+                assert_eq!(su[j], if s[j] == NO_NODE { NO_NODE } else { s[j] + n0 });
+            }
+        }
+        let total: usize = (0..u.node_count()).map(|i| u.incident_edges(i).len()).sum();
+        assert_eq!(total, 2 * u.edges().len());
+        assert_counter_clockwise(&u);
     }
 
     #[test]

@@ -1,0 +1,11 @@
+//! # atelier
+//!
+//! The facade (issue 7, in progress): a garment's gridded panels assembled into one cloth with
+//! its seams ([`assemble`]), and dressing by sewing ([`sewing`], thesis §5.6): seam node pairs
+//! drawn together with gravity off, each pair sewn once it is closer than a threshold.
+
+pub mod assemble;
+pub mod sewing;
+
+pub use assemble::{AssembleError, GarmentCloth};
+pub use sewing::{Chain, Sewing, SewingParams};

@@ -1,0 +1,151 @@
+//! Dressing by sewing (thesis §5.6): the panels are placed around the body, the node pairs of
+//! every seam are drawn together (the thesis: by springs, with gravity off), and a pair closer
+//! than a threshold is sewn — from then on its two nodes move as one. Gravity starts when every
+//! pair is sewn.
+//!
+//! The pull is written as a velocity: each step an unsewn pair closes a fixed fraction of its gap
+//! (a critically damped spring in effect: no overshoot, no oscillation), shared between its nodes
+//! by inverse mass. A sewn pair is held together after every collision pass: both nodes are given
+//! the velocities that bring them to their mass-weighted mean end position, which conserves their
+//! momentum.
+
+use atelier_collide::V3;
+use atelier_solver::{CollisionHook, HookContext};
+
+/// How the seams are closed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SewingParams {
+    /// Fraction of an unsewn pair's gap closed per step (0 < rate ≤ 1).
+    pub rate: f64,
+    /// A pair closer than this is sewn, m.
+    pub threshold: f64,
+    /// Largest closing speed of a pair, m/s (keeps the cloth from being yanked).
+    pub max_speed: f64,
+}
+
+impl Default for SewingParams {
+    fn default() -> Self {
+        Self {
+            rate: 0.1,
+            threshold: 2e-3,
+            max_speed: 1.0,
+        }
+    }
+}
+
+/// The sewing stage, as a collision hook.
+pub struct Sewing {
+    params: SewingParams,
+    pairs: Vec<(u32, u32)>,
+    sewn: Vec<bool>,
+}
+
+impl Sewing {
+    /// Sew `pairs` (node indices of the cloth).
+    pub fn new(pairs: Vec<(u32, u32)>, params: SewingParams) -> Self {
+        let sewn = vec![false; pairs.len()];
+        Self {
+            params,
+            pairs,
+            sewn,
+        }
+    }
+
+    /// Pairs sewn so far, of all.
+    pub fn progress(&self) -> (usize, usize) {
+        (self.sewn.iter().filter(|&&s| s).count(), self.sewn.len())
+    }
+
+    /// Whether every pair is sewn.
+    pub fn done(&self) -> bool {
+        self.sewn.iter().all(|&s| s)
+    }
+
+    /// The largest distance between the two nodes of a pair at `positions`.
+    pub fn largest_gap(&self, positions: &[V3]) -> f64 {
+        self.pairs
+            .iter()
+            .map(|&(a, b)| (positions[a as usize] - positions[b as usize]).norm())
+            .fold(0.0, f64::max)
+    }
+}
+
+impl CollisionHook for Sewing {
+    fn transfer(&mut self, ctx: HookContext<'_>) {
+        let (x, v, w) = (ctx.positions, ctx.velocities, ctx.inverse_masses);
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            let gap = x[b] - x[a];
+            if !self.sewn[k] && gap.norm() < self.params.threshold {
+                self.sewn[k] = true;
+            }
+            if self.sewn[k] {
+                continue;
+            }
+            let ws = w[a] + w[b];
+            if ws <= 0.0 {
+                continue;
+            }
+            // Close `rate` of the gap this step, relative to the pair's current motion.
+            let mut want = gap * (self.params.rate / ctx.dt) - (v[b] - v[a]);
+            let speed = want.norm();
+            if speed > self.params.max_speed {
+                want *= self.params.max_speed / speed;
+            }
+            v[a] += want * (w[a] / ws);
+            v[b] -= want * (w[b] / ws);
+        }
+    }
+
+    fn resolve(&mut self, ctx: HookContext<'_>) {
+        let (x, v, w, dt) = (ctx.positions, ctx.velocities, ctx.inverse_masses, ctx.dt);
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            if !self.sewn[k] {
+                continue;
+            }
+            let (a, b) = (a as usize, b as usize);
+            let ws = w[a] + w[b];
+            if ws <= 0.0 {
+                continue;
+            }
+            let (ea, eb) = (x[a] + v[a] * dt, x[b] + v[b] * dt);
+            // Mass-weighted mean: weights are the masses, i.e. the other node's inverse mass.
+            let e = (ea * w[b] + eb * w[a]) / ws;
+            v[a] = (e - x[a]) / dt;
+            v[b] = (e - x[b]) / dt;
+        }
+    }
+}
+
+/// Several hooks called in order (sewing, then the body).
+pub struct Chain(pub Vec<Box<dyn CollisionHook>>);
+
+impl CollisionHook for Chain {
+    fn transfer(&mut self, ctx: HookContext<'_>) {
+        for h in &mut self.0 {
+            h.transfer(HookContext {
+                positions: ctx.positions,
+                velocities: &mut *ctx.velocities,
+                exit: &mut *ctx.exit,
+                inverse_masses: ctx.inverse_masses,
+                dt: ctx.dt,
+                time: ctx.time,
+                pass: ctx.pass,
+            });
+        }
+    }
+
+    fn resolve(&mut self, ctx: HookContext<'_>) {
+        for h in &mut self.0 {
+            h.resolve(HookContext {
+                positions: ctx.positions,
+                velocities: &mut *ctx.velocities,
+                exit: &mut *ctx.exit,
+                inverse_masses: ctx.inverse_masses,
+                dt: ctx.dt,
+                time: ctx.time,
+                pass: ctx.pass,
+            });
+        }
+    }
+}
