@@ -15,8 +15,8 @@ use atelier_solver::{CollisionHook, HookContext};
 /// How the seams are closed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SewingParams {
-    /// Fraction of an unsewn pair's gap closed per step (0 < rate ≤ 1).
-    pub rate: f64,
+    /// Natural angular frequency ω of the critically damped pull, rad/s.
+    pub omega: f64,
     /// A pair closer than this is sewn, m.
     pub threshold: f64,
     /// Largest closing speed of a pair, m/s (keeps the cloth from being yanked).
@@ -26,7 +26,7 @@ pub struct SewingParams {
 impl Default for SewingParams {
     fn default() -> Self {
         Self {
-            rate: 0.1,
+            omega: 10.0,
             threshold: 2e-3,
             max_speed: 1.0,
         }
@@ -54,6 +54,11 @@ impl Sewing {
     /// Pairs sewn so far, of all.
     pub fn progress(&self) -> (usize, usize) {
         (self.sewn.iter().filter(|&&s| s).count(), self.sewn.len())
+    }
+
+    /// Indices of the pairs not sewn yet.
+    pub fn unsewn(&self) -> Vec<usize> {
+        (0..self.sewn.len()).filter(|&k| !self.sewn[k]).collect()
     }
 
     /// Whether every pair is sewn.
@@ -86,11 +91,13 @@ impl CollisionHook for Sewing {
             if ws <= 0.0 {
                 continue;
             }
-            // Close `rate` of the gap this step, relative to the pair's current motion.
-            let mut want = gap * (self.params.rate / ctx.dt) - (v[b] - v[a]);
+            let w0 = self.params.omega;
+            let mut want = (gap * (w0 * w0) - (v[b] - v[a]) * (2.0 * w0)) * ctx.dt;
+            // Never faster than `max_speed` towards each other.
+            let closing = (v[a] - v[b]).dot(&gap) / gap.norm().max(f64::MIN_POSITIVE);
             let speed = want.norm();
-            if speed > self.params.max_speed {
-                want *= self.params.max_speed / speed;
+            if closing + speed > self.params.max_speed && speed > 0.0 {
+                want *= ((self.params.max_speed - closing).max(0.0) / speed).min(1.0);
             }
             v[a] += want * (w[a] / ws);
             v[b] -= want * (w[b] / ws);
@@ -117,10 +124,10 @@ impl CollisionHook for Sewing {
     }
 }
 
-/// Several hooks called in order (sewing, then the body).
-pub struct Chain(pub Vec<Box<dyn CollisionHook>>);
+/// Several hooks called in order (sewing, then the body), borrowed for a step.
+pub struct Chain<'a>(pub Vec<&'a mut dyn CollisionHook>);
 
-impl CollisionHook for Chain {
+impl CollisionHook for Chain<'_> {
     fn transfer(&mut self, ctx: HookContext<'_>) {
         for h in &mut self.0 {
             h.transfer(HookContext {
