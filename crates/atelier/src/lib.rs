@@ -2,10 +2,12 @@
 //!
 //! The facade (issue 7, in progress): a garment's gridded panels assembled into one cloth with
 //! its seams ([`assemble`]), and dressing by sewing ([`sewing`], thesis §5.6): seam node pairs
-//! drawn together with gravity off, each pair sewn once it is closer than a threshold.
+//! drawn together with gravity off, each pair sewn once it is closer than a threshold; and
+//! [`validate`], the checks behind `atelier validate FILE…`.
 
 pub mod assemble;
 pub mod sewing;
+pub mod validate;
 
 pub use assemble::{AssembleError, GarmentCloth};
 pub use sewing::{Chain, Sewing, SewingParams};

@@ -1,0 +1,134 @@
+//! `atelier validate FILE…`: check atelier's data files — fabrics, patterns, garments, body
+//! descriptions, motions, range-image side files (RON) and external bodies (OBJ, PLY) — and
+//! report each problem with file:line:column and field.
+//!
+//! A RON file's kind is found by trying each format: the first that reads it names it; when none
+//! does, the error reported is the one that got furthest into the file (the format the file most
+//! likely is), with that format's name.
+
+use std::path::Path;
+
+use atelier_fabric::{FileError, Position};
+
+/// What a file turned out to be.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A fabric (`fixtures/fabrics`).
+    Fabric,
+    /// A sewing pattern.
+    Pattern,
+    /// A garment (panels and seams; its patterns are read and gridded too).
+    Garment,
+    /// A mannequin description.
+    BodyDescription,
+    /// A motion (checked against the default 9AR mannequin's joint limits).
+    Motion,
+    /// A range image's side file.
+    RangeSide,
+    /// An external body mesh (OBJ or PLY).
+    Mesh,
+}
+
+impl Kind {
+    /// Lower-case name for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Fabric => "fabric",
+            Kind::Pattern => "pattern",
+            Kind::Garment => "garment",
+            Kind::BodyDescription => "body description",
+            Kind::Motion => "motion",
+            Kind::RangeSide => "range side file",
+            Kind::Mesh => "mesh",
+        }
+    }
+}
+
+/// The outcome for one file: its kind, or the error (with the kind it was most likely meant to
+/// be, when known).
+pub type Outcome = Result<Kind, (Option<Kind>, FileError)>;
+
+/// Check one file.
+pub fn validate(path: &Path) -> Outcome {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    if ext == "obj" || ext == "ply" {
+        return atelier_body::io::load_mesh(path)
+            .map(|_| Kind::Mesh)
+            .map_err(|e| (Some(Kind::Mesh), e));
+    }
+    // Unreadable files: one error, no guessing.
+    if let Err(e) = std::fs::metadata(path) {
+        return Err((
+            None,
+            FileError {
+                file: path.to_path_buf(),
+                position: None,
+                field: String::new(),
+                kind: atelier_fabric::ErrorKind::Io,
+                message: e.to_string(),
+                source: Some(e),
+            },
+        ));
+    }
+    let attempts: [(Kind, &dyn Fn(&Path) -> Result<(), FileError>); 6] = [
+        (Kind::Fabric, &|p| {
+            atelier_fabric::Fabric::load(p).map(|_| ())
+        }),
+        (Kind::Pattern, &|p| {
+            let spec = atelier_grid::pattern::load_pattern(p)?;
+            atelier_grid::pattern::grid_pattern(&spec, atelier_grid::ImproveParams::default())
+                .map(|_| ())
+                .map_err(|e| FileError::from_invalid(p, e))
+        }),
+        (Kind::Garment, &|p| {
+            atelier_grid::pattern::load_garment(p, atelier_grid::ImproveParams::default())
+                .map(|_| ())
+        }),
+        (Kind::BodyDescription, &|p| {
+            atelier_body::description::BodyDescription::load(p).map(|_| ())
+        }),
+        (Kind::Motion, &|p| {
+            atelier_body::Motion::load(p, &atelier_body::build::jis_9ar()).map(|_| ())
+        }),
+        (Kind::RangeSide, &|p| {
+            atelier_fabric::files::load_ron::<atelier_grid::range::SideFile>(p).map(|_| ())
+        }),
+    ];
+    let mut best: Option<(Kind, FileError)> = None;
+    for (kind, attempt) in attempts {
+        match attempt(path) {
+            Ok(()) => return Ok(kind),
+            Err(e) => {
+                let further = match (&best, e.position) {
+                    (None, _) => true,
+                    (Some((_, b)), Some(p)) => b.position.is_none_or(|q| later(p, q)),
+                    (Some(_), None) => false,
+                };
+                if further {
+                    best = Some((kind, e));
+                }
+            }
+        }
+    }
+    let (kind, e) = best.expect("at least one attempt");
+    Err((Some(kind), e))
+}
+
+fn later(a: Position, b: Position) -> bool {
+    (a.line, a.column) > (b.line, b.column)
+}
+
+/// One line per file: `ok  FILE (kind)` or `error  FILE:LINE:COL: field …: message (as kind)`.
+pub fn report_line(path: &Path, outcome: &Outcome) -> String {
+    match outcome {
+        Ok(kind) => format!("ok     {} ({})", path.display(), kind.name()),
+        Err((kind, e)) => match kind {
+            Some(k) => format!("error  {e} (read as a {})", k.name()),
+            None => format!("error  {e}"),
+        },
+    }
+}
