@@ -74,7 +74,7 @@ pub fn validate(path: &Path) -> Outcome {
             },
         ));
     }
-    let attempts: [(Kind, &dyn Fn(&Path) -> Result<(), FileError>); 6] = [
+    let attempts: [(Kind, &Check); 6] = [
         (Kind::Fabric, &|p| {
             atelier_fabric::Fabric::load(p).map(|_| ())
         }),
@@ -117,6 +117,9 @@ pub fn validate(path: &Path) -> Outcome {
     let (kind, e) = best.expect("at least one attempt");
     Err((Some(kind), e))
 }
+
+/// A reader that checks a file as one kind.
+type Check = dyn Fn(&Path) -> Result<(), FileError>;
 
 fn later(a: Position, b: Position) -> bool {
     (a.line, a.column) > (b.line, b.column)
