@@ -341,58 +341,8 @@ fn rasterise(
             continue;
         }
         facing += 1;
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let (mut c0, mut c1, mut r0, mut r1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for q in &p {
-            c0 = c0.min(q[0]);
-            c1 = c1.max(q[0]);
-            r0 = r0.min(q[1]);
-            r1 = r1.max(q[1]);
-        }
-        let (c0, c1) = (
-            (c0 - 1e-9).ceil().max(0.0),
-            (c1 + 1e-9).floor().min((w - 1) as f64),
-        );
-        let (r0, r1) = (
-            (r0 - 1e-9).ceil().max(0.0),
-            (r1 + 1e-9).floor().min((h - 1) as f64),
-        );
-        if c0 > c1 || r0 > r1 {
-            continue;
-        }
         let label = mesh.triangle_part[t].index() as u8;
-        for r in r0 as usize..=r1 as usize {
-            let y = r as f64;
-            for c in c0 as usize..=c1 as usize {
-                let x = c as f64;
-                let l1 = ((x - p[0][0]) * (p[2][1] - p[0][1])
-                    - (p[2][0] - p[0][0]) * (y - p[0][1]))
-                    / det;
-                let l2 = ((p[1][0] - p[0][0]) * (y - p[0][1])
-                    - (x - p[0][0]) * (p[1][1] - p[0][1]))
-                    / det;
-                let l0 = 1.0 - l1 - l2;
-                // The same inclusive test as `atelier_grid::range::measure_error`.
-                let eps = -1e-9;
-                if l0 < eps || l1 < eps || l2 < eps {
-                    continue;
-                }
-                let zz = l0 * p[0][2] + l1 * p[1][2] + l2 * p[2][2];
-                let k = r * w + c;
-                let better = z[k].is_nan() || if front { zz > z[k] } else { zz < z[k] };
-                if better {
-                    z[k] = zz;
-                    part[k] = label;
-                }
-            }
-        }
+        atelier_grid::range::measure::rasterize_triangle(p, label, front, w, h, &mut z, &mut part);
     }
     if facing == 0 {
         return Err(RangeError::NoFacingTriangles(view));

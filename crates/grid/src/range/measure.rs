@@ -76,64 +76,76 @@ fn render(mesh: &BodyMesh, body: &RangeBody, front: bool) -> (Vec<f64>, Vec<u8>)
             let c = body.pixel([q[0] * 1e3, q[1] * 1e3]);
             [c[0], c[1], q[2] * 1e3]
         });
-        let det =
-            (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let cmin = p
-            .iter()
-            .map(|q| q[0])
-            .fold(f64::INFINITY, f64::min)
-            .ceil()
-            .max(0.0);
-        let cmax = p
-            .iter()
-            .map(|q| q[0])
-            .fold(f64::NEG_INFINITY, f64::max)
-            .floor()
-            .min((w - 1) as f64);
-        let rmin = p
-            .iter()
-            .map(|q| q[1])
-            .fold(f64::INFINITY, f64::min)
-            .ceil()
-            .max(0.0);
-        let rmax = p
-            .iter()
-            .map(|q| q[1])
-            .fold(f64::NEG_INFINITY, f64::max)
-            .floor()
-            .min((h - 1) as f64);
-        if cmin > cmax || rmin > rmax {
-            continue;
-        }
         let label = mesh.triangle_part[t].index() as u8;
-        for r in rmin as usize..=rmax as usize {
-            for c in cmin as usize..=cmax as usize {
-                let (x, y) = (c as f64, r as f64);
-                let l1 = ((x - p[0][0]) * (p[2][1] - p[0][1])
-                    - (p[2][0] - p[0][0]) * (y - p[0][1]))
-                    / det;
-                let l2 = ((p[1][0] - p[0][0]) * (y - p[0][1])
-                    - (x - p[0][0]) * (p[1][1] - p[0][1]))
-                    / det;
-                let l0 = 1.0 - l1 - l2;
-                let eps = -1e-9;
-                if l0 < eps || l1 < eps || l2 < eps {
-                    continue;
-                }
-                let zz = l0 * p[0][2] + l1 * p[1][2] + l2 * p[2][2];
-                let k = r * w + c;
-                let better = z[k].is_nan() || if front { zz > z[k] } else { zz < z[k] };
-                if better {
-                    z[k] = zz;
-                    part[k] = label;
-                }
+        rasterize_triangle(p, label, front, w, h, &mut z, &mut part);
+    }
+    (z, part)
+}
+
+/// Rasterise one triangle given in pixel coordinates (column, row) with its depth (mm, world
+/// z): at every pixel centre inside it (inclusive, 1e-9 tolerance on the barycentric
+/// coordinates) keep the depth nearest the camera — the largest z for the front view, the
+/// smallest for the back — and `label`. `z` (NaN = empty) and `part` are `w × h`, row by row.
+/// Shared by this error measure and by the range-image renderer of `atelier-body`, so both see
+/// exactly the same pixels.
+pub fn rasterize_triangle(
+    p: [[f64; 3]; 3],
+    label: u8,
+    front: bool,
+    w: usize,
+    h: usize,
+    z: &mut [f64],
+    part: &mut [u8],
+) {
+    let det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+    if det.abs() < 1e-12 || w == 0 || h == 0 {
+        return;
+    }
+    let (mut c0, mut c1, mut r0, mut r1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for q in &p {
+        c0 = c0.min(q[0]);
+        c1 = c1.max(q[0]);
+        r0 = r0.min(q[1]);
+        r1 = r1.max(q[1]);
+    }
+    let (c0, c1) = (
+        (c0 - 1e-9).ceil().max(0.0),
+        (c1 + 1e-9).floor().min((w - 1) as f64),
+    );
+    let (r0, r1) = (
+        (r0 - 1e-9).ceil().max(0.0),
+        (r1 + 1e-9).floor().min((h - 1) as f64),
+    );
+    if c0 > c1 || r0 > r1 {
+        return;
+    }
+    for r in r0 as usize..=r1 as usize {
+        let y = r as f64;
+        for c in c0 as usize..=c1 as usize {
+            let x = c as f64;
+            let l1 =
+                ((x - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (y - p[0][1])) / det;
+            let l2 =
+                ((p[1][0] - p[0][0]) * (y - p[0][1]) - (x - p[0][0]) * (p[1][1] - p[0][1])) / det;
+            let l0 = 1.0 - l1 - l2;
+            let eps = -1e-9;
+            if l0 < eps || l1 < eps || l2 < eps {
+                continue;
+            }
+            let zz = l0 * p[0][2] + l1 * p[1][2] + l2 * p[2][2];
+            let k = r * w + c;
+            let better = z[k].is_nan() || if front { zz > z[k] } else { zz < z[k] };
+            if better {
+                z[k] = zz;
+                part[k] = label;
             }
         }
     }
-    (z, part)
 }
 
 #[derive(Default, Clone, Copy)]
