@@ -3,6 +3,7 @@
 //! The human body of the PARTY thesis (§2.4 (II), §4.6.2, §5.6): a surface of triangles split
 //! into 17 rigid parts in a tree with movable joints, driven by keyframed motion.
 
+pub mod articulate;
 pub mod build;
 pub mod description;
 pub mod io;
