@@ -9,7 +9,9 @@ use atelier_body::{Body, LabelledMesh, Motion};
 use plotters::prelude::*;
 
 use crate::plot::png;
-use crate::render::{Fit, View, part_colour, render, screen_box, to_rgb};
+use atelier::picture::{Fit, View, part_colour, render, screen_box};
+
+use crate::plot::to_rgb;
 
 /// Draw the body figures into `out`; returns the files written.
 pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {

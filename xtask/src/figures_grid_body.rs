@@ -10,7 +10,9 @@ use atelier_grid::range::{BodyGridParams, BodyMesh, ErrorImage, Part, grid_body,
 use plotters::prelude::*;
 
 use crate::plot::png;
-use crate::render::{Fit, View, part_colour, render, screen_box, to_rgb};
+use atelier::picture::{Fit, View, part_colour, render, screen_box};
+
+use crate::plot::to_rgb;
 
 /// Draw the body figures into `out`.
 pub fn draw_all(out: &Path) -> Result<Vec<PathBuf>> {

@@ -16,7 +16,6 @@ mod figures_grid;
 mod figures_grid_body;
 mod figures_solver;
 mod plot;
-mod render;
 
 use std::path::{Path, PathBuf};
 

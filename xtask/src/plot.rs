@@ -130,3 +130,9 @@ fn trim(x: f64) -> String {
     let s = format!("{x:.4}");
     s.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
+
+/// A plotters colour from components in [0, 1].
+pub fn to_rgb(c: [f64; 3]) -> RGBColor {
+    let [r, g, b] = atelier::picture::to_bytes(c);
+    RGBColor(r, g, b)
+}

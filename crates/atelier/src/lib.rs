@@ -6,6 +6,7 @@
 //! [`validate`], the checks behind `atelier validate FILE…`.
 
 pub mod assemble;
+pub mod picture;
 pub mod sewing;
 pub mod validate;
 

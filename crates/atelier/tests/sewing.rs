@@ -74,6 +74,23 @@ fn the_flared_skirt_sews_itself_shut_and_stays_sewn() {
             .iter()
             .all(|p| p.iter().all(|c| c.is_finite()))
     );
+    // The picture of the final state: the skirt shows in both views.
+    let points: Vec<[f64; 3]> = state.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let (w, h) = (300, 400);
+    let pixels =
+        atelier::picture::garment_views((&points, g.cloth.topology().triangles()), None, w, h);
+    let out = std::env::temp_dir().join(format!("atelier-sewn-skirt-{}.png", std::process::id()));
+    atelier::picture::write_png(&out, &pixels, 2 * w, h, [1.0; 3]).expect("png");
+    eprintln!("picture: {}", out.display());
+    // Two flat panels sewn at their edges hang as a flattened bag: wide from the front, thin
+    // from the side.
+    for (half, least) in [(0, 5_000), (1, 500)] {
+        let cloth = (0..h)
+            .flat_map(|y| (0..w).map(move |x| y * 2 * w + half * w + x))
+            .filter(|&k| pixels[k].is_some())
+            .count();
+        assert!(cloth > least, "view {half}: {cloth} cloth pixels");
+    }
     // The skirt now hangs: its lowest point fell below where it started.
     let lowest = state
         .positions

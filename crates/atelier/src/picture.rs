@@ -1,8 +1,9 @@
-//! A small orthographic z-buffer renderer for the figures (no maintained software-rasteriser
-//! crate fits, see `dependencies.md`): flat-shaded triangles coloured per triangle, seen from
-//! the front, the back or the body's left side, scaled to fit a box.
+//! Pictures without a GPU: a small orthographic z-buffer renderer (no maintained
+//! software-rasteriser crate fits, see `dependencies.md`) — flat-shaded triangles coloured per
+//! triangle, seen from the front, the back or the body's left side, scaled to fit — and PNG
+//! output written atomically. The figure sets of `xtask` and the pipeline's pictures use it.
 
-use plotters::prelude::RGBColor;
+use std::path::Path;
 
 /// Which way the camera looks (frame: x = the body's left, y up, z forward).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -138,10 +139,35 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-/// An RGB colour from components in [0, 1].
-pub fn to_rgb(c: [f64; 3]) -> RGBColor {
-    let q = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-    RGBColor(q(c[0]), q(c[1]), q(c[2]))
+/// Bytes of a colour with components in [0, 1].
+pub fn to_bytes(c: [f64; 3]) -> [u8; 3] {
+    c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+}
+
+/// Write an RGB picture (`w × h`, row 0 at the top; `None` pixels take `background`) as a PNG,
+/// atomically (a temporary file beside `path`, renamed when complete).
+pub fn write_png(
+    path: &Path,
+    pixels: &[Option<[f64; 3]>],
+    w: usize,
+    h: usize,
+    background: [f64; 3],
+) -> std::io::Result<()> {
+    let mut bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut bytes, w as u32, h as u32);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut writer = enc.write_header().map_err(std::io::Error::other)?;
+        let data: Vec<u8> = pixels
+            .iter()
+            .flat_map(|p| to_bytes(p.unwrap_or(background)))
+            .collect();
+        writer
+            .write_image_data(&data)
+            .map_err(std::io::Error::other)?;
+    }
+    atelier_fabric::files::write_atomic(path, &bytes)
 }
 
 /// One colour per body part index (hues spread by the golden ratio).
@@ -162,4 +188,62 @@ fn hsv(h: f64, s: f64, v: f64) -> [f64; 3] {
         4 => [t, p, v],
         _ => [v, p, q],
     }
+}
+
+/// Colour of the cloth in the pipeline's pictures.
+pub const CLOTH: [f64; 3] = [0.85, 0.35, 0.25];
+/// Colour of the body.
+pub const BODY: [f64; 3] = [0.75, 0.75, 0.78];
+
+/// The final state as the pipeline draws it: front (left half) and left side (right half) of
+/// the cloth, with the body when there is one, in distinct colours, shaded, one scale for both
+/// views. Returns the pixels of a `2w × h` picture.
+pub fn garment_views(
+    cloth: (&[[f64; 3]], &[[u32; 3]]),
+    body: Option<(&[[f64; 3]], &[[u32; 3]])>,
+    w: usize,
+    h: usize,
+) -> Vec<Option<[f64; 3]>> {
+    // One scene: cloth triangles first, then the body's, indices shifted.
+    let mut points: Vec<[f64; 3]> = cloth.0.to_vec();
+    let mut triangles: Vec<[u32; 3]> = cloth.1.to_vec();
+    let n_cloth = triangles.len();
+    if let Some((bp, bt)) = body {
+        let base = points.len() as u32;
+        points.extend_from_slice(bp);
+        triangles.extend(bt.iter().map(|t| t.map(|k| k + base)));
+    }
+    // Cloth seen from inside (its back faces) is drawn too: a garment's inside shows at the hem.
+    let mut two_sided = triangles.clone();
+    two_sided.extend(triangles[..n_cloth].iter().map(|t| [t[0], t[2], t[1]]));
+    let colour = |t: usize| {
+        if t < n_cloth || t >= triangles.len() {
+            CLOTH
+        } else {
+            BODY
+        }
+    };
+    let mut span = [0.0f64; 2];
+    for view in [View::Front, View::Left] {
+        let (lo, hi) = screen_box(&points, view);
+        span = [span[0].max(hi[0] - lo[0]), span[1].max(hi[1] - lo[1])];
+    }
+    let mut out = vec![None; 2 * w * h];
+    for (k, view) in [View::Front, View::Left].into_iter().enumerate() {
+        let (lo, hi) = screen_box(&points, view);
+        let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+        let fit = Fit::new(
+            [c[0] - 0.5 * span[0], c[1] - 0.5 * span[1]],
+            [c[0] + 0.5 * span[0], c[1] + 0.5 * span[1]],
+            w,
+            h,
+        );
+        let pixels = render(&points, &two_sided, &colour, view, fit, w, h);
+        for y in 0..h {
+            for x in 0..w {
+                out[y * 2 * w + k * w + x] = pixels[y * w + x];
+            }
+        }
+    }
+    out
 }
