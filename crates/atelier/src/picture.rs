@@ -190,6 +190,9 @@ fn hsv(h: f64, s: f64, v: f64) -> [f64; 3] {
     }
 }
 
+/// A triangle mesh by reference: vertex positions (m) and triangles.
+pub type MeshRef<'a> = (&'a [[f64; 3]], &'a [[u32; 3]]);
+
 /// Colour of the cloth in the pipeline's pictures.
 pub const CLOTH: [f64; 3] = [0.85, 0.35, 0.25];
 /// Colour of the body.
@@ -199,8 +202,8 @@ pub const BODY: [f64; 3] = [0.75, 0.75, 0.78];
 /// the cloth, with the body when there is one, in distinct colours, shaded, one scale for both
 /// views. Returns the pixels of a `2w × h` picture.
 pub fn garment_views(
-    cloth: (&[[f64; 3]], &[[u32; 3]]),
-    body: Option<(&[[f64; 3]], &[[u32; 3]])>,
+    cloth: MeshRef<'_>,
+    body: Option<MeshRef<'_>>,
     w: usize,
     h: usize,
 ) -> Vec<Option<[f64; 3]>> {
