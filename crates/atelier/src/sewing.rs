@@ -128,31 +128,28 @@ impl CollisionHook for Sewing {
 pub struct Chain<'a>(pub Vec<&'a mut dyn CollisionHook>);
 
 impl CollisionHook for Chain<'_> {
-    fn transfer(&mut self, ctx: HookContext<'_>) {
+    fn transfer(&mut self, mut ctx: HookContext<'_>) {
         for h in &mut self.0 {
-            h.transfer(HookContext {
-                positions: ctx.positions,
-                velocities: &mut *ctx.velocities,
-                exit: &mut *ctx.exit,
-                inverse_masses: ctx.inverse_masses,
-                dt: ctx.dt,
-                time: ctx.time,
-                pass: ctx.pass,
-            });
+            h.transfer(reborrow(&mut ctx));
         }
     }
 
-    fn resolve(&mut self, ctx: HookContext<'_>) {
+    fn resolve(&mut self, mut ctx: HookContext<'_>) {
         for h in &mut self.0 {
-            h.resolve(HookContext {
-                positions: ctx.positions,
-                velocities: &mut *ctx.velocities,
-                exit: &mut *ctx.exit,
-                inverse_masses: ctx.inverse_masses,
-                dt: ctx.dt,
-                time: ctx.time,
-                pass: ctx.pass,
-            });
+            h.resolve(reborrow(&mut ctx));
         }
+    }
+}
+
+/// The same context again, for the next hook of a chain.
+fn reborrow<'b>(ctx: &'b mut HookContext<'_>) -> HookContext<'b> {
+    HookContext {
+        positions: ctx.positions,
+        velocities: &mut *ctx.velocities,
+        exit: &mut *ctx.exit,
+        inverse_masses: ctx.inverse_masses,
+        dt: ctx.dt,
+        time: ctx.time,
+        pass: ctx.pass,
     }
 }

@@ -65,12 +65,7 @@ pub fn point_triangle_thesis(
     thickness: f64,
     sides: Sides,
 ) -> Option<Hit> {
-    let n0 = (x[1] - x[0]).cross(&(x[2] - x[0]));
-    let area2 = n0.norm();
-    if area2 <= 0.0 || !area2.is_finite() {
-        return None;
-    }
-    let mut n = n0 / area2;
+    let mut n = unit_normal(x)?;
     let mut s0 = (p - x[0]).dot(&n);
     if s0 < -thickness {
         if sides == Sides::Front {
@@ -100,6 +95,13 @@ pub fn point_triangle_thesis(
     })
 }
 
+/// The unit normal of a triangle (counter-clockwise), `None` for a degenerate one.
+fn unit_normal(x: [&V3; 3]) -> Option<V3> {
+    let n = (x[1] - x[0]).cross(&(x[2] - x[0]));
+    let len = n.norm();
+    (len > 0.0 && len.is_finite()).then(|| n / len)
+}
+
 /// Barycentric tolerance of the inside test.
 const INSIDE: f64 = 1e-9;
 
@@ -114,12 +116,7 @@ pub fn point_triangle(
     thickness: f64,
     sides: Sides,
 ) -> Option<Hit> {
-    let n0 = (x[1] - x[0]).cross(&(x[2] - x[0]));
-    let area2 = n0.norm();
-    if area2 <= 0.0 || !area2.is_finite() {
-        return None;
-    }
-    let n = n0 / area2;
+    let n = unit_normal(x)?;
     let s0 = (p - x[0]).dot(&n);
     // Resting contact: within the skin, projecting inside, approaching.
     if s0.abs() <= thickness && (sides == Sides::Both || s0 >= -thickness) {

@@ -422,20 +422,7 @@ fn the_renderer_agrees_with_the_analytic_mannequin() {
 fn check_round_trip(m: &Mannequin, max_mean_mm: f64) -> RoundTrip {
     let rt = round_trip(m, 2.5, &BodyGridParams::default()).unwrap();
     let e = &rt.error;
-    eprintln!("part              nodes  tris  samples  |Ze−Zr| mm      signed mm");
-    for (p, s) in &e.parts {
-        eprintln!(
-            "{:<16} {:6} {:5} {:8}  {:5.2} ± {:5.2}  {:6.2} ± {:5.2}",
-            p.name(),
-            s.nodes,
-            s.triangles,
-            s.samples,
-            s.mean_abs_mm,
-            s.sd_abs_mm,
-            s.mean_signed_mm,
-            s.sd_signed_mm
-        );
-    }
+    eprint!("{}", e.table());
     eprintln!(
         "{}: {} × {} px, render {:.1} ms, render + landmarks {:.3} s, gridding {:.3} s; total {:.2} ± {:.2} mm (signed {:.2} ± {:.2}), {} nodes / {} valid samples = {:.2} %, uncovered {}, spurious {}",
         m.name,

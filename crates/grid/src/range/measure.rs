@@ -66,6 +66,32 @@ pub struct ErrorReport {
     pub back: ErrorImage,
 }
 
+impl ErrorReport {
+    /// The per-part table of the thesis's Table 2 (nodes, triangles, samples, |Z_e − Z_r| and
+    /// the signed error, mm) with a total row, as text.
+    pub fn table(&self) -> String {
+        let row = |name: &str, s: &ErrorStats| {
+            format!(
+                "{name:<16} {:6} {:5} {:8}  {:5.2} ± {:5.2}  {:6.2} ± {:5.2}\n",
+                s.nodes,
+                s.triangles,
+                s.samples,
+                s.mean_abs_mm,
+                s.sd_abs_mm,
+                s.mean_signed_mm,
+                s.sd_signed_mm
+            )
+        };
+        let mut out =
+            String::from("part              nodes  tris  samples  |Ze−Zr| mm      signed mm\n");
+        for (p, s) in &self.parts {
+            out.push_str(&row(p.name(), s));
+        }
+        out.push_str(&row("total", &self.total));
+        out
+    }
+}
+
 fn render(mesh: &BodyMesh, body: &RangeBody, front: bool) -> (Vec<f64>, Vec<u8>) {
     let (w, h) = (body.width, body.height);
     let mut z = vec![f64::NAN; w * h];

@@ -45,31 +45,7 @@ fn same_body(a: &RangeBody, b: &RangeBody) -> bool {
 
 /// Print the Table-2 style report (visible with `--nocapture`).
 fn print_report(err: &ErrorReport, grid: &BodyGridReport) {
-    eprintln!("part              nodes  tris  samples  |Ze−Zr| mm      signed mm");
-    for (p, s) in &err.parts {
-        eprintln!(
-            "{:<16} {:6} {:5} {:8}  {:5.2} ± {:5.2}  {:6.2} ± {:5.2}",
-            p.name(),
-            s.nodes,
-            s.triangles,
-            s.samples,
-            s.mean_abs_mm,
-            s.sd_abs_mm,
-            s.mean_signed_mm,
-            s.sd_signed_mm
-        );
-    }
-    let t = err.total;
-    eprintln!(
-        "total            {:6} {:5} {:8}  {:5.2} ± {:5.2}  {:6.2} ± {:5.2}",
-        t.nodes,
-        t.triangles,
-        t.samples,
-        t.mean_abs_mm,
-        t.sd_abs_mm,
-        t.mean_signed_mm,
-        t.sd_signed_mm
-    );
+    eprint!("{}", err.table());
     eprintln!(
         "valid samples {} → compression {:.2} %; uncovered {}, spurious {}; gridding {:.3} s",
         err.valid_samples,
