@@ -6,7 +6,9 @@
 //! [`validate`], the checks behind `atelier validate FILE…`.
 
 pub mod assemble;
+pub mod export;
 pub mod picture;
+pub mod place;
 pub mod sewing;
 pub mod validate;
 

@@ -106,10 +106,11 @@ impl CollisionHook for Sewing {
 
     fn resolve(&mut self, ctx: HookContext<'_>) {
         let (x, v, w, dt) = (ctx.positions, ctx.velocities, ctx.inverse_masses, ctx.dt);
+        // The gap an unsewn pair may keep at the end of this pass: it closes by the fraction
+        // ω·Δt of its predicted gap per pass, at most `max_speed·Δt`.
+        let rate = (self.params.omega * dt).min(1.0);
+        let most = self.params.max_speed * dt;
         for (k, &(a, b)) in self.pairs.iter().enumerate() {
-            if !self.sewn[k] {
-                continue;
-            }
             let (a, b) = (a as usize, b as usize);
             let ws = w[a] + w[b];
             if ws <= 0.0 {
@@ -118,8 +119,22 @@ impl CollisionHook for Sewing {
             let (ea, eb) = (x[a] + v[a] * dt, x[b] + v[b] * dt);
             // Mass-weighted mean: weights are the masses, i.e. the other node's inverse mass.
             let e = (ea * w[b] + eb * w[a]) / ws;
-            v[a] = (e - x[a]) / dt;
-            v[b] = (e - x[b]) / dt;
+            if self.sewn[k] {
+                v[a] = (e - x[a]) / dt;
+                v[b] = (e - x[b]) / dt;
+            } else {
+                let gap = eb - ea;
+                let len = gap.norm();
+                let keep = if len > 0.0 {
+                    (len - (rate * len).min(most)) / len
+                } else {
+                    0.0
+                };
+                // Both ends move towards the mean, keeping `keep` of the gap (momentum kept).
+                let (na, nb) = (e - gap * (keep * w[a] / ws), e + gap * (keep * w[b] / ws));
+                v[a] = (na - x[a]) / dt;
+                v[b] = (nb - x[b]) / dt;
+            }
         }
     }
 }

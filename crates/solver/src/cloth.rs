@@ -80,6 +80,10 @@ pub enum ClothError {
     },
 }
 
+/// Shear angle at which the secant shear stiffness is taken for a fabric without KES shear
+/// values, rad (2°, inside KES's 0.5°–5° range for G).
+const SECANT_SHEAR_ANGLE: f64 = 2.0 * std::f64::consts::PI / 180.0;
+
 /// One piece of cloth: topology, materials, masses and pins. Immutable during a simulation
 /// (pins are set before the first step).
 #[derive(Clone, Debug)]
@@ -97,6 +101,7 @@ pub struct Cloth {
     diagonal_list: Vec<u32>,
     phase_slot: Vec<u32>,
     shear: ShearCurve,
+    diagonal_stiffness: Vec<f64>,
     mass: Vec<f64>,
     inv_mass: Vec<f64>,
     pins: Vec<Pin>,
@@ -236,8 +241,24 @@ impl Cloth {
                 phase_slot[e as usize] = k as u32;
             }
         }
+        let shear = ShearCurve::from_fabric(fabric);
+        // A compliant diagonal's spring constant: with the fabric's shear stiffness G a cell of
+        // rest area S sheared by γ stores ½ G γ² S; its two diagonals of rest length d change by
+        // ∓ S γ / d each, so k = G d² / (2 S) per diagonal (k = G for a square cell).
+        let g = fabric.shear.as_ref().map_or_else(
+            || shear.secant_stiffness(SECANT_SHEAR_ANGLE),
+            |s| s.stiffness,
+        );
+        let mut diagonal_stiffness = vec![0.0; topology.edges().len()];
+        for cell in topology.cells() {
+            for d in cell.diagonals {
+                let l = topology.edges()[d as usize].rest_length;
+                diagonal_stiffness[d as usize] = g * l * l / (2.0 * cell.area);
+            }
+        }
         Ok(Self {
-            shear: ShearCurve::from_fabric(fabric),
+            shear,
+            diagonal_stiffness,
             topology,
             fabric: fabric.clone(),
             form,
@@ -427,6 +448,13 @@ impl Cloth {
     /// The in-plane shear characteristic of the cells.
     pub fn shear_curve(&self) -> &ShearCurve {
         &self.shear
+    }
+
+    /// Spring constant of each diagonal when diagonals are compliant
+    /// (`ConstraintKind::Compliant`), N/m; 0 for axial edges. From the fabric's KES shear
+    /// stiffness G, or when the fabric has none the secant of its shear curve at 2°.
+    pub fn diagonal_stiffness(&self) -> &[f64] {
+        &self.diagonal_stiffness
     }
 
     /// Node masses μ = m_A·S, kg.

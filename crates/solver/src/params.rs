@@ -51,6 +51,11 @@ pub enum ConstraintKind {
     Equality,
     /// Only stretching beyond the target is corrected (the cloth may shrink in plane).
     StretchOnly,
+    /// Diagonals only: an elastic spring of the fabric's shear stiffness (`Cloth::
+    /// diagonal_stiffness`) held by a compliant (XPBD) constraint instead of a rigid one, so a
+    /// cell shears under in-plane load as the fabric does (a rigid cell of four sides and two
+    /// diagonals cannot change shape at all). Needs the Jacobi or Chebyshev shape method.
+    Compliant,
 }
 
 /// The thresholds ε^c (internal forces) and ε^e (shape), fixed or scaled with the cloth's speed
@@ -254,6 +259,25 @@ impl StepParams {
             self.collision_passes >= 1,
             "≥ 1",
         )?;
+        if self.axial_constraint == ConstraintKind::Compliant {
+            return Err(ParamError {
+                name: "axial_constraint",
+                value: 0.0,
+                range: "Equality or StretchOnly (Compliant is for diagonals)",
+            });
+        }
+        if self.diagonal_constraint == ConstraintKind::Compliant
+            && !matches!(
+                self.shape_method,
+                ShapeMethod::Jacobi | ShapeMethod::Chebyshev { .. }
+            )
+        {
+            return Err(ParamError {
+                name: "diagonal_constraint",
+                value: 0.0,
+                range: "Compliant needs the Jacobi or Chebyshev shape method",
+            });
+        }
         match self.shape_method {
             ShapeMethod::Chebyshev { rho } => {
                 check("shape_method.rho", rho, rho > 0.0 && rho < 1.0, "(0, 1)")?
@@ -335,6 +359,32 @@ impl StepParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Compliant constraints: diagonals only, and only with the local shape methods.
+    #[test]
+    fn compliant_constraints_are_checked() {
+        let ok = StepParams {
+            diagonal_constraint: ConstraintKind::Compliant,
+            ..StepParams::default()
+        };
+        ok.validate().expect("compliant diagonals with Chebyshev");
+        let axial = StepParams {
+            axial_constraint: ConstraintKind::Compliant,
+            ..StepParams::default()
+        };
+        assert_eq!(
+            axial.validate().expect_err("axial").name,
+            "axial_constraint"
+        );
+        let newton = StepParams {
+            shape_method: ShapeMethod::GaussSeidel { omega: 1.0 },
+            ..ok
+        };
+        assert_eq!(
+            newton.validate().expect_err("GS").name,
+            "diagonal_constraint"
+        );
+    }
 
     #[test]
     fn defaults_are_valid_and_ranges_are_enforced() {

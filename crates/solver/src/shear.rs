@@ -44,6 +44,25 @@ impl ShearCurve {
         Self { tau_max, gamma }
     }
 
+    /// Secant stiffness τ/γ at shear angle `gamma` (rad), N/(m·rad): the force per width at which
+    /// the curve reaches `gamma`, found by bisection, divided by `gamma`. When the curve never
+    /// reaches `gamma` the secant at τ_max is returned.
+    pub fn secant_stiffness(&self, gamma: f64) -> f64 {
+        if self.angle(self.tau_max) <= gamma {
+            return self.tau_max / self.angle(self.tau_max).max(f64::MIN_POSITIVE);
+        }
+        let (mut lo, mut hi) = (0.0, self.tau_max);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if self.angle(mid) < gamma {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi) / gamma
+    }
+
     /// Shear angle at shear force per width `tau` (N/m), rad; odd in τ, constant beyond τ_max.
     pub fn angle(&self, tau: f64) -> f64 {
         let x = ((tau.abs() / self.tau_max).sqrt() * SAMPLES as f64).min(SAMPLES as f64);

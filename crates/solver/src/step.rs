@@ -228,6 +228,8 @@ struct Scratch {
     force_per_width: Vec<f64>,
     target: Vec<f64>,
     shear: Vec<f64>,
+    /// Accumulated XPBD multipliers of compliant diagonals (reset each step).
+    lambda_c: Vec<f64>,
     vel: Vec<V3>,
     vel_prev: Vec<V3>,
     vel_hat: Vec<V3>,
@@ -629,6 +631,7 @@ impl Solver {
             &mut s.grad,
             &mut s.force_per_width,
             &mut s.target,
+            &mut s.lambda_c,
             &mut s.c,
             &mut s.cg_x,
             &mut s.cg_r,
@@ -1314,7 +1317,12 @@ impl Solver {
             .count();
         let shear_curve = cloth.shear_curve();
         let cells = topo.cells();
+        let compliant = params.diagonal_constraint == ConstraintKind::Compliant;
         fill(&mut s.shear, |c| {
+            if compliant {
+                // The spring carries the shear; the targets keep the rest angle.
+                return 0.0;
+            }
             let cell = &cells[c];
             let [dp, dm] = cell
                 .diagonals
@@ -1362,12 +1370,18 @@ impl Solver {
         let mut iterations = 0;
         let mut cg_total = 0;
         self.s.vel_prev.copy_from_slice(&self.s.vel);
+        self.s.lambda_c.fill(0.0);
+        let stiffness = cloth.diagonal_stiffness();
         for k in 0..params.shape_max_iterations {
             let s = &mut self.s;
             let (pos, vel, target) = (&state.positions, &s.vel, &s.target);
             let (axial_kind, diagonal_kind) = (params.axial_constraint, params.diagonal_constraint);
+            let gamma = params.shape_step;
             // Per edge, at the predicted positions r + ṙΔt: unit direction and length error.
-            let edge_error = |(e, (dir, c)): (usize, (&mut V3, &mut f64))| {
+            // A compliant edge (XPBD, α̃ = 1/(k Δt²)) corrects C + α̃λ scaled by w/(w + α̃) and
+            // accumulates λ by the part its nodes actually take (γ over their constraint
+            // counts); at the fixed point C = −α̃λ, the spring force −kC.
+            let edge_error = |(e, ((dir, c), lambda)): (usize, ((&mut V3, &mut f64), &mut f64))| {
                 let edge = &edges[e];
                 let (a, b) = (edge.a as usize, edge.b as usize);
                 let d = (pos[b] - pos[a]) + (vel[b] - vel[a]) * dt;
@@ -1381,18 +1395,33 @@ impl Solver {
                 *c = match kind {
                     ConstraintKind::Equality => l - target[e],
                     ConstraintKind::StretchOnly => (l - target[e]).max(0.0),
+                    ConstraintKind::Compliant => {
+                        let w = inv[a] + inv[b];
+                        if w == 0.0 {
+                            0.0
+                        } else {
+                            let alpha = 1.0 / (stiffness[e] * dt * dt);
+                            let corr = (l - target[e] + alpha * *lambda) * w / (w + alpha);
+                            let n =
+                                0.5 * (cloth.incidence(a).len() + cloth.incidence(b).len()) as f64;
+                            *lambda -= corr * gamma / (n * w);
+                            corr
+                        }
+                    }
                 };
             };
             if edges.len() >= PAR_MIN {
                 s.cdir
                     .par_iter_mut()
                     .zip(s.c.par_iter_mut())
+                    .zip(s.lambda_c.par_iter_mut())
                     .enumerate()
                     .for_each(edge_error);
             } else {
                 s.cdir
                     .iter_mut()
                     .zip(s.c.iter_mut())
+                    .zip(s.lambda_c.iter_mut())
                     .enumerate()
                     .for_each(edge_error);
             }
@@ -1470,8 +1499,10 @@ impl Solver {
                                 params.diagonal_constraint
                             };
                             let mut c = l - target[e as usize];
-                            if kind == ConstraintKind::StretchOnly {
-                                c = c.max(0.0);
+                            match kind {
+                                ConstraintKind::StretchOnly => c = c.max(0.0),
+                                // Rejected by `StepParams::validate`.
+                                ConstraintKind::Compliant | ConstraintKind::Equality => {}
                             }
                             if l == 0.0 || c == 0.0 {
                                 return vel[i];
@@ -1655,6 +1686,8 @@ impl Solver {
                 match kind {
                     ConstraintKind::Equality => err.abs(),
                     ConstraintKind::StretchOnly => err.max(0.0),
+                    // A spring: its stretch is the shear, not an error.
+                    ConstraintKind::Compliant => 0.0,
                 }
             })
             .fold(0.0, f64::max)
