@@ -8,6 +8,7 @@
 pub mod assemble;
 pub mod export;
 pub mod picture;
+pub mod pipeline;
 pub mod place;
 pub mod sewing;
 pub mod validate;
