@@ -10,6 +10,9 @@ pub mod export;
 pub mod picture;
 pub mod pipeline;
 pub mod place;
+pub mod report;
+pub mod run;
+pub mod scenario;
 pub mod sewing;
 pub mod validate;
 

@@ -1,6 +1,6 @@
 //! `atelier validate FILE…`: check atelier's data files — fabrics, patterns, garments, body
-//! descriptions, motions, range-image side files (RON) and external bodies (OBJ, PLY) — and
-//! report each problem with file:line:column and field.
+//! descriptions, motions, range-image side files, scenarios (RON) and external bodies (OBJ,
+//! PLY) — and report each problem with file:line:column and field.
 //!
 //! A RON file's kind is found by trying each format: the first that reads it names it; when none
 //! does, the error reported is the one that got furthest into the file (the format the file most
@@ -27,6 +27,8 @@ pub enum Kind {
     RangeSide,
     /// An external body mesh (OBJ or PLY).
     Mesh,
+    /// A scenario (the files it names must exist).
+    Scenario,
 }
 
 impl Kind {
@@ -40,6 +42,7 @@ impl Kind {
             Kind::Motion => "motion",
             Kind::RangeSide => "range side file",
             Kind::Mesh => "mesh",
+            Kind::Scenario => "scenario",
         }
     }
 }
@@ -74,7 +77,7 @@ pub fn validate(path: &Path) -> Outcome {
             },
         ));
     }
-    let attempts: [(Kind, &Check); 6] = [
+    let attempts: [(Kind, &Check); 7] = [
         (Kind::Fabric, &|p| {
             atelier_fabric::Fabric::load(p).map(|_| ())
         }),
@@ -96,6 +99,11 @@ pub fn validate(path: &Path) -> Outcome {
         }),
         (Kind::RangeSide, &|p| {
             atelier_fabric::files::load_ron::<atelier_grid::range::SideFile>(p).map(|_| ())
+        }),
+        (Kind::Scenario, &|p| {
+            let s = crate::scenario::Scenario::load(p)?;
+            s.check_files(&crate::run::base_of(p))
+                .map_err(|e| FileError::from_invalid(p, e))
         }),
     ];
     let mut best: Option<(Kind, FileError)> = None;

@@ -1,25 +1,58 @@
-//! The `atelier` command-line program (issue 7, in progress): `atelier validate FILE…`.
+//! The `atelier` command-line program.
+//!
+//! - `atelier` (no arguments): run the built-in default scenario — the dress (or skirt) sewn on
+//!   the 9AR mannequin, then a short walk — into `./atelier-out`.
+//! - `atelier run SCENARIO.ron --out DIR [--threads N] [--frames K]`: run a scenario file.
+//! - `atelier validate FILE…`: check data files.
+//!
+//! Exit status: 0 success; 1 the run could not start or its outputs could not be written (bad
+//! file, missing file, unwritable folder); 2 the run ended early (diverged) or an expectation
+//! was not met — its report and outputs are written all the same. Errors are one line on
+//! stderr, never a backtrace.
 
-use std::path::PathBuf;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use atelier::export::FrameSelection;
+use atelier::run::{RunOptions, base_of, run};
+use atelier::scenario::Scenario;
 use clap::{Parser, Subcommand};
+
+/// The built-in default scenario (`fixtures/scenarios/default.ron`), embedded at build time.
+const DEFAULT_SCENARIO: &str = include_str!("../../../../fixtures/scenarios/default.ron");
+
+/// The folder the default scenario's relative paths are resolved against: the repository's
+/// `fixtures/scenarios`, found through the crate's source location at build time (the garment,
+/// fabric and motion files it names are read from the repository at run time).
+const DEFAULT_BASE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/scenarios");
 
 #[derive(Parser)]
 #[command(
     name = "atelier",
     version,
-    about = "Garments from measured fabric mechanics"
+    about = "Garments from measured fabric mechanics",
+    long_about = "Garments from measured fabric mechanics.\n\nWith no command, runs the built-in default scenario (the dress sewn on the 9AR mannequin, then a short walk) into ./atelier-out."
 )]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
 }
 
 #[derive(Subcommand)]
 enum Command {
-    /// Check fabric, pattern, garment, body, motion and range side files (RON) and body meshes
-    /// (OBJ, PLY); print each problem with file:line:column and field.
+    /// Run a scenario file: report.json, final.obj, final.ply, run.glb and final.png in DIR.
+    Run {
+        /// Scenario file (RON).
+        scenario: PathBuf,
+        /// Output folder (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        #[command(flatten)]
+        options: Options,
+    },
+    /// Check fabric, pattern, garment, body, motion, range side and scenario files (RON) and
+    /// body meshes (OBJ, PLY); print each problem with file:line:column and field.
     Validate {
         /// Files to check.
         #[arg(required = true)]
@@ -27,26 +60,135 @@ enum Command {
     },
 }
 
+#[derive(clap::Args, Clone, Copy)]
+struct Options {
+    /// Worker threads of the parallel stages (default: one per core).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
+    /// Keep at most K frames in run.glb (K ≥ 2; default: every recorded frame).
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(2..))]
+    frames: Option<u32>,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Validate { files } => {
-            let mut failed = 0;
-            for f in &files {
-                let outcome = atelier::validate::validate(f);
-                failed += usize::from(outcome.is_err());
-                // The report is the program's output.
+        None => {
+            let base = PathBuf::from(DEFAULT_BASE);
+            if !base.is_dir() {
+                eprintln!(
+                    "atelier: the default scenario's fixtures are not at {} (the program was moved away from its source tree); run `atelier run SCENARIO.ron --out DIR` instead",
+                    base.display()
+                );
+                return ExitCode::FAILURE;
+            }
+            let scenario =
+                match Scenario::parse(DEFAULT_SCENARIO, Path::new("<built-in default.ron>")) {
+                    Ok(s) => s,
+                    Err(e) => {
+                        eprintln!("atelier: {e}");
+                        return ExitCode::FAILURE;
+                    }
+                };
+            let options = Options {
+                threads: None,
+                frames: None,
+            };
+            run_scenario(&scenario, None, &base, Path::new("atelier-out"), options)
+        }
+        Some(Command::Run {
+            scenario,
+            out,
+            options,
+        }) => match Scenario::load(&scenario) {
+            Ok(s) => run_scenario(&s, Some(&scenario), &base_of(&scenario), &out, options),
+            Err(e) => {
+                eprintln!("atelier: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Some(Command::Validate { files }) => validate(&files),
+    }
+}
+
+fn run_scenario(
+    scenario: &Scenario,
+    file: Option<&Path>,
+    base: &Path,
+    out: &Path,
+    options: Options,
+) -> ExitCode {
+    if let Some(n) = options.threads
+        && let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(usize::from(n))
+            .build_global()
+    {
+        eprintln!("atelier: cannot start {n} threads: {e}");
+        return ExitCode::FAILURE;
+    }
+    let run_options = RunOptions {
+        frames: options
+            .frames
+            .map_or(FrameSelection::All, |k| FrameSelection::AtMost(k as usize)),
+        ..RunOptions::default()
+    };
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} [{elapsed_precise}] {wide_bar} {percent:>3}% (eta {eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_message(scenario.name.clone());
+        bar
+    });
+    let mut progress = |f: f64| {
+        if let Some(b) = &bar {
+            b.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
+        }
+    };
+    let result = run(scenario, file, base, out, &run_options, &mut progress);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    match result {
+        Ok(report) => {
+            let line = format!("{} (outputs in {})", report.summary_line(), out.display());
+            if report.passed() {
+                // The summary is the program's output.
                 #[allow(clippy::print_stdout)]
                 {
-                    println!("{}", atelier::validate::report_line(f, &outcome));
+                    println!("{line}");
                 }
-            }
-            if failed > 0 {
-                eprintln!("{failed} of {} files have problems", files.len());
-                ExitCode::FAILURE
-            } else {
                 ExitCode::SUCCESS
+            } else {
+                eprintln!("atelier: {line}");
+                ExitCode::from(2)
             }
         }
+        Err(e) => {
+            eprintln!("atelier: {}: {e}", scenario.name);
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn validate(files: &[PathBuf]) -> ExitCode {
+    let mut failed = 0;
+    for f in files {
+        let outcome = atelier::validate::validate(f);
+        failed += usize::from(outcome.is_err());
+        // The report is the program's output.
+        #[allow(clippy::print_stdout)]
+        {
+            println!("{}", atelier::validate::report_line(f, &outcome));
+        }
+    }
+    if failed > 0 {
+        eprintln!("{failed} of {} files have problems", files.len());
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
     }
 }

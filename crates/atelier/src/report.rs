@@ -1,0 +1,218 @@
+//! The report of a run (`report.json`): what was run, its size, its cost, its metrics, whether
+//! its expectations were met, and what went wrong. The schema, every field with its unit, is
+//! `docs/report.md`; [`Report::FORMAT`] names its version.
+//!
+//! The `metrics` object depends only on the scenario and the arithmetic of the run (no wall
+//! times), so two runs of the same scenario with one thread write identical `metrics` bytes.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::run::{RunError, Simulated, check_expectations};
+use crate::scenario::Scenario;
+
+/// The scenario a report is about.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioInfo {
+    /// Its name.
+    pub name: String,
+    /// The file it was read from (as given), or `null` for the built-in default.
+    pub file: Option<String>,
+    /// Kind: `Garment`, `Drape`, `Cantilever` or `Catenary`.
+    pub kind: String,
+    /// What it reproduces.
+    pub reproduces: String,
+}
+
+/// Wall time per stage of the step, summed over the run, s.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StageSeconds {
+    /// Normals, curvature, bending force.
+    pub bending: f64,
+    /// Internal forces.
+    pub internal: f64,
+    /// Unconstrained velocity.
+    pub velocity: f64,
+    /// Geometric transfer of body motion.
+    pub transfer: f64,
+    /// Shape constraint iterations.
+    pub shape: f64,
+    /// Collision passes (body, self, sewing pull).
+    pub collision: f64,
+    /// Position update, hysteresis, diagnostics.
+    pub update: f64,
+    /// Sum of the stages.
+    pub total: f64,
+}
+
+/// One expectation and its outcome.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectationResult {
+    /// Metric name.
+    pub metric: String,
+    /// Lower bound, if any.
+    pub min: Option<f64>,
+    /// Upper bound, if any.
+    pub max: Option<f64>,
+    /// The metric's value (`null`: not measured).
+    pub value: Option<f64>,
+    /// Whether the bound was met.
+    pub met: bool,
+}
+
+/// The whole report.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Report {
+    /// Schema name and version: [`Report::FORMAT`].
+    pub format: String,
+    /// Version of atelier that wrote it.
+    pub atelier_version: String,
+    /// The scenario.
+    pub scenario: ScenarioInfo,
+    /// The fabric's name.
+    pub fabric: String,
+    /// Cloth nodes.
+    pub nodes: usize,
+    /// Cloth triangles.
+    pub triangles: usize,
+    /// Body (or tester) triangles; 0 when there is none.
+    pub body_triangles: usize,
+    /// Steps taken.
+    pub steps: usize,
+    /// Time step Δt, s.
+    pub dt_s: f64,
+    /// Simulated time reached, s.
+    pub simulated_s: f64,
+    /// Wall time of the steps, s.
+    pub wall_s: f64,
+    /// Wall time of everything else before writing (loading, gridding, placing, measuring), s.
+    pub setup_s: f64,
+    /// Wall time per stage, s.
+    pub stage_s: StageSeconds,
+    /// Worker threads of the parallel stages.
+    pub threads: usize,
+    /// Metrics by name (units in the names); `null` when not measured.
+    pub metrics: BTreeMap<String, Option<f64>>,
+    /// Each expectation with its outcome.
+    pub expectations: Vec<ExpectationResult>,
+    /// Every expectation met (true when there are none).
+    pub expectations_met: bool,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+    /// The failure that ended the run early (`null`: none).
+    pub failure: Option<String>,
+    /// The files written beside the report.
+    pub outputs: Vec<String>,
+}
+
+impl Report {
+    /// The schema's name and version.
+    pub const FORMAT: &'static str = "atelier-report/1";
+
+    /// The report of a simulation (outputs and setup time filled in by the runner).
+    pub fn new(scenario: &Scenario, file: Option<&Path>, sim: &Simulated) -> Self {
+        let expectations = check_expectations(scenario, &sim.metrics);
+        let t = &sim.timings;
+        let stage_s = StageSeconds {
+            bending: t.bending.as_secs_f64(),
+            internal: t.internal.as_secs_f64(),
+            velocity: t.velocity.as_secs_f64(),
+            transfer: t.transfer.as_secs_f64(),
+            shape: t.shape.as_secs_f64(),
+            collision: t.collision.as_secs_f64(),
+            update: t.update.as_secs_f64(),
+            total: t.total().as_secs_f64(),
+        };
+        Self {
+            format: Self::FORMAT.into(),
+            atelier_version: env!("CARGO_PKG_VERSION").into(),
+            scenario: ScenarioInfo {
+                name: scenario.name.clone(),
+                file: file.map(|f| f.display().to_string()),
+                kind: scenario.kind.name().into(),
+                reproduces: scenario.reproduces.clone(),
+            },
+            fabric: sim.fabric.clone(),
+            nodes: sim.cloth.frames.first().map_or(0, Vec::len),
+            triangles: sim.cloth_triangles.len(),
+            body_triangles: sim.solid.as_ref().map_or(0, |s| s.triangles.len()),
+            steps: sim.steps,
+            dt_s: sim.dt,
+            simulated_s: sim.simulated,
+            wall_s: sim.wall_seconds,
+            setup_s: 0.0,
+            stage_s,
+            threads: rayon::current_num_threads(),
+            metrics: sim.metrics.clone(),
+            expectations_met: expectations.iter().all(|e| e.met),
+            expectations,
+            warnings: sim.warnings.clone(),
+            failure: sim.failure.clone(),
+            outputs: Vec::new(),
+        }
+    }
+
+    /// Pretty JSON, ending with a newline.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).expect("a report serialises");
+        s.push('\n');
+        s
+    }
+
+    /// Read a report back.
+    pub fn from_json(text: &str) -> Result<Self, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+
+    /// Write the report atomically.
+    pub fn write(&self, path: &Path) -> Result<(), RunError> {
+        atelier_fabric::files::write_atomic(path, self.to_json().as_bytes()).map_err(|source| {
+            RunError::Output {
+                path: path.to_path_buf(),
+                source,
+            }
+        })
+    }
+
+    /// Whether the run succeeded: no failure and every expectation met.
+    pub fn passed(&self) -> bool {
+        self.failure.is_none() && self.expectations_met
+    }
+
+    /// One line: name, outcome, steps and wall time, and the failure or unmet expectations.
+    pub fn summary_line(&self) -> String {
+        let head = format!(
+            "{}: {} steps, {:.2} s simulated in {:.2} s wall",
+            self.scenario.name, self.steps, self.simulated_s, self.wall_s
+        );
+        if let Some(f) = &self.failure {
+            return format!("FAILED {head}: {f}");
+        }
+        let unmet: Vec<String> = self
+            .expectations
+            .iter()
+            .filter(|e| !e.met)
+            .map(|e| {
+                let value = e.value.map_or("not measured".into(), |v| format!("{v:.4}"));
+                let bound = match (e.min, e.max) {
+                    (Some(a), Some(b)) => format!("[{a}, {b}]"),
+                    (Some(a), None) => format!("≥ {a}"),
+                    (None, Some(b)) => format!("≤ {b}"),
+                    (None, None) => String::new(),
+                };
+                format!("{} = {value} not {bound}", e.metric)
+            })
+            .collect();
+        if unmet.is_empty() {
+            format!("ok {head}")
+        } else {
+            format!("EXPECTATION NOT MET {head}: {}", unmet.join("; "))
+        }
+    }
+}

@@ -1,0 +1,893 @@
+//! Run a scenario ([`crate::scenario`]) into an output folder: simulate it ([`simulate`]), then
+//! write the report (`report.json`, [`crate::report`]), the final state as OBJ and PLY, the whole
+//! run as an animated glTF binary and pictures of the final state ([`run`]).
+//!
+//! Every file is written under a temporary name beside its target and renamed when complete;
+//! the report is written last, so a folder whose `report.json` is new holds a complete set. A
+//! run that fails part-way (a step diverges) still writes everything, up to its last good frame,
+//! with the failure in the report.
+//!
+//! Frames: garment scenes are in the body frame (x the body's left, y up, z forward). The
+//! validation scenes (drape, cantilever, catenary) are simulated with z up, as in the solver's
+//! scenes; their outputs are turned into the same y-up frame, (x, y, z) → (x, z, −y), so that
+//! every output has y up as glTF expects.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use atelier_fabric::{AnisotropyForm, Fabric};
+use atelier_grid::{ClothTopology, StructuredGrid};
+use atelier_solver::scenes::DrapeScene;
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StageTimings, StepParams};
+use nalgebra::Vector3;
+
+use crate::export::{
+    Animation, ExportError, FrameSelection, GlbOptions, MeshPart, write_glb, write_obj, write_ply,
+};
+use crate::pipeline::run_garment;
+use crate::report::{ExpectationResult, Report};
+use crate::scenario::{
+    CantileverSpec, CatenarySpec, DrapeSpec, Scenario, ScenarioKind, StripDirection, Tester,
+};
+
+/// Why a scenario could not be run or its outputs not written. (A run that diverges is not an
+/// error: it is a [`Simulated`] with a failure, and its outputs are written.)
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scene could not be set up (a file it names, a parameter out of range).
+    #[error("{0}")]
+    Setup(String),
+    /// The output folder could not be created or written.
+    #[error("cannot write {}: {source}", path.display())]
+    Output {
+        /// The folder or file.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// A fixed part drawn and exported with the cloth: the body, or a drape tester's support.
+#[derive(Clone, Debug)]
+pub struct Solid {
+    /// Part name in the exports (`body`, `support`, `platform`).
+    pub name: &'static str,
+    /// Triangles (vertex indices), outward.
+    pub triangles: Vec<[u32; 3]>,
+    /// Its positions over the run (one frame when it does not move).
+    pub motion: Animation,
+}
+
+/// What a simulation produced, before anything is written.
+#[derive(Clone, Debug)]
+pub struct Simulated {
+    /// The fabric's name.
+    pub fabric: String,
+    /// Cloth triangles (node indices).
+    pub cloth_triangles: Vec<[u32; 3]>,
+    /// Cloth node positions over the run (y up), the last frame the final or last good state.
+    pub cloth: Animation,
+    /// The body or the tester, if any.
+    pub solid: Option<Solid>,
+    /// Steps taken.
+    pub steps: usize,
+    /// Time step, s.
+    pub dt: f64,
+    /// Simulated time reached, s.
+    pub simulated: f64,
+    /// Wall time of the steps, s.
+    pub wall_seconds: f64,
+    /// Wall time per stage, summed over the steps.
+    pub timings: StageTimings,
+    /// Metrics by name (see [`ScenarioKind::metric_names`]); `None` when not measured (for
+    /// example a drape coefficient after a failed step).
+    pub metrics: BTreeMap<String, Option<f64>>,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+    /// The failure that ended the run early.
+    pub failure: Option<String>,
+}
+
+/// Options of [`run`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RunOptions {
+    /// Frames kept in the glTF animation (default: all).
+    pub frames: FrameSelection,
+    /// Width and height of each view of the picture, pixels (default 400 × 600).
+    pub picture: (usize, usize),
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self {
+            frames: FrameSelection::All,
+            picture: (400, 600),
+        }
+    }
+}
+
+/// The file names a run writes into its folder.
+pub mod outputs {
+    /// The report.
+    pub const REPORT: &str = "report.json";
+    /// The final state, Wavefront OBJ.
+    pub const OBJ: &str = "final.obj";
+    /// The final state, binary PLY.
+    pub const PLY: &str = "final.ply";
+    /// The whole run, glTF binary.
+    pub const GLB: &str = "run.glb";
+    /// Front and side views of the final state.
+    pub const PICTURE: &str = "final.png";
+    /// View from above (drape tests).
+    pub const TOP: &str = "top.png";
+    /// Every name above.
+    pub const ALL: [&str; 6] = [REPORT, OBJ, PLY, GLB, PICTURE, TOP];
+}
+
+/// Colour of the cloth in exports and pictures.
+const CLOTH_COLOUR: [f32; 3] = [0.85, 0.35, 0.25];
+/// Colour of the body or tester.
+const SOLID_COLOUR: [f32; 3] = [0.75, 0.75, 0.78];
+
+/// Run `scenario` (read from `file`, whose folder `base` resolves its relative paths) into the
+/// folder `out` (created if missing): simulate, check the expectations, write the outputs and
+/// the report. `progress` receives the fraction of simulated time done. Returns the report; a
+/// run that diverged returns `Ok` with the failure in the report.
+pub fn run(
+    scenario: &Scenario,
+    file: Option<&Path>,
+    base: &Path,
+    out: &Path,
+    options: &RunOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Report, RunError> {
+    prepare_folder(out)?;
+    let clock = Instant::now();
+    let sim = simulate(scenario, base, progress)?;
+    let setup_seconds = (clock.elapsed().as_secs_f64() - sim.wall_seconds).max(0.0);
+    let mut report = Report::new(scenario, file, &sim);
+    report.setup_s = setup_seconds;
+    let mut options = *options;
+    if !matches!(scenario.kind, ScenarioKind::Garment(_)) {
+        // The validation scenes are wider than tall: square views.
+        options.picture.1 = options.picture.0;
+    }
+    let (written, warnings) = write_outputs(&sim, out, &options, scenario_is_drape(scenario))?;
+    report.outputs = written;
+    report.warnings.extend(warnings);
+    report.write(&out.join(outputs::REPORT))?;
+    Ok(report)
+}
+
+fn scenario_is_drape(s: &Scenario) -> bool {
+    matches!(s.kind, ScenarioKind::Drape(_))
+}
+
+/// Create the output folder and remove temporary files a killed run may have left beside the
+/// outputs.
+fn prepare_folder(out: &Path) -> Result<(), RunError> {
+    std::fs::create_dir_all(out).map_err(|source| RunError::Output {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let entries = std::fs::read_dir(out).map_err(|source| RunError::Output {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let stale = outputs::ALL.iter().any(|target| {
+            let stem = target.split('.').next().unwrap_or(target);
+            name.starts_with(&format!(".{stem}.tmp-"))
+        });
+        if stale {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+    Ok(())
+}
+
+/// Write the exports and pictures; returns the names written and warnings for exports that
+/// could not be made (other than for I/O, which is an error).
+fn write_outputs(
+    sim: &Simulated,
+    out: &Path,
+    options: &RunOptions,
+    top_view: bool,
+) -> Result<(Vec<String>, Vec<String>), RunError> {
+    let mut written = Vec::new();
+    let mut warnings = Vec::new();
+    let Some(final_cloth) = sim.cloth.last() else {
+        warnings.push("no frame to write".into());
+        return Ok((written, warnings));
+    };
+    let cloth_part = MeshPart::cloth("cloth", &sim.cloth_triangles, CLOTH_COLOUR);
+    let solid_part = sim
+        .solid
+        .as_ref()
+        .map(|s| (MeshPart::body(s.name, &s.triangles, SOLID_COLOUR), s));
+    let mut still: Vec<(MeshPart<'_>, &[[f64; 3]])> = vec![(cloth_part, final_cloth)];
+    if let Some((part, s)) = &solid_part
+        && let Some(last) = s.motion.last()
+    {
+        still.push((*part, last));
+    }
+    let mut export = |name: &str, result: Result<(), ExportError>| -> Result<(), RunError> {
+        match result {
+            Ok(()) => {
+                written.push(name.to_string());
+                Ok(())
+            }
+            Err(ExportError::Io { path, source }) => Err(RunError::Output { path, source }),
+            Err(e) => {
+                warnings.push(format!("{name} not written: {e}"));
+                Ok(())
+            }
+        }
+    };
+    export(outputs::OBJ, write_obj(&out.join(outputs::OBJ), &still))?;
+    export(outputs::PLY, write_ply(&out.join(outputs::PLY), &still))?;
+    let mut animated: Vec<(MeshPart<'_>, &Animation)> = vec![(cloth_part, &sim.cloth)];
+    if let Some((part, s)) = &solid_part {
+        animated.push((*part, &s.motion));
+    }
+    let glb = GlbOptions {
+        frames: options.frames,
+        ..GlbOptions::default()
+    };
+    export(
+        outputs::GLB,
+        write_glb(&out.join(outputs::GLB), &animated, &glb),
+    )?;
+
+    let (w, h) = options.picture;
+    let solid_final = solid_part
+        .as_ref()
+        .and_then(|(_, s)| s.motion.last().map(|p| (p, s.triangles.as_slice())));
+    let pixels =
+        crate::picture::garment_views((final_cloth, &sim.cloth_triangles), solid_final, w, h);
+    let path = out.join(outputs::PICTURE);
+    crate::picture::write_png(&path, &pixels, 2 * w, h, [1.0; 3])
+        .map_err(|source| RunError::Output { path, source })?;
+    written.push(outputs::PICTURE.into());
+    if top_view {
+        // Seen from above: screen x = x, screen y = −z (forward is down), depth y.
+        let down = |p: &[f64; 3]| [p[0], -p[2], p[1]];
+        let cloth: Vec<[f64; 3]> = final_cloth.iter().map(down).collect();
+        let solid_points: Option<Vec<[f64; 3]>> =
+            solid_final.map(|(p, _)| p.iter().map(down).collect());
+        let solid = solid_points.as_deref().zip(solid_final.map(|(_, t)| t));
+        let pixels = crate::picture::garment_views((&cloth, &sim.cloth_triangles), solid, h, h);
+        // Keep the left (front) half: the view from above.
+        let mut top = Vec::with_capacity(h * h);
+        for row in pixels.chunks(2 * h) {
+            top.extend_from_slice(&row[..h]);
+        }
+        let path = out.join(outputs::TOP);
+        crate::picture::write_png(&path, &top, h, h, [1.0; 3])
+            .map_err(|source| RunError::Output { path, source })?;
+        written.push(outputs::TOP.into());
+    }
+    Ok((written, warnings))
+}
+
+/// Check each expectation against the metrics.
+pub fn check_expectations(
+    scenario: &Scenario,
+    metrics: &BTreeMap<String, Option<f64>>,
+) -> Vec<ExpectationResult> {
+    scenario
+        .expectations
+        .iter()
+        .map(|e| {
+            let value = metrics.get(&e.metric).copied().flatten();
+            ExpectationResult {
+                metric: e.metric.clone(),
+                min: e.min,
+                max: e.max,
+                value,
+                met: e.met_by(value),
+            }
+        })
+        .collect()
+}
+
+/// Simulate a scenario (nothing is written). `base` resolves its relative paths.
+pub fn simulate(
+    scenario: &Scenario,
+    base: &Path,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulated, RunError> {
+    let fabric_path = base.join(scenario.kind.fabric());
+    let fabric = Fabric::load(&fabric_path).map_err(|e| RunError::Setup(e.to_string()))?;
+    let mut sim = match &scenario.kind {
+        ScenarioKind::Garment(spec) => garment(spec, base, progress)?,
+        ScenarioKind::Drape(spec) => drape(spec, &fabric, progress)?,
+        ScenarioKind::Cantilever(spec) => cantilever(spec, &fabric, progress)?,
+        ScenarioKind::Catenary(spec) => catenary(spec, &fabric, progress)?,
+    };
+    sim.fabric = fabric.name.clone();
+    trim_non_finite(&mut sim);
+    sim.metrics
+        .insert("nodes".into(), Some(node_count(&sim) as f64));
+    sim.metrics.insert(
+        "cloth_triangles".into(),
+        Some(sim.cloth_triangles.len() as f64),
+    );
+    sim.simulated = round_time(sim.simulated);
+    sim.metrics
+        .insert("simulated_s".into(), Some(sim.simulated));
+    sim.metrics
+        .insert("frames".into(), Some(sim.cloth.frames.len() as f64));
+    progress(1.0);
+    Ok(sim)
+}
+
+fn node_count(sim: &Simulated) -> usize {
+    sim.cloth.frames.first().map_or(0, Vec::len)
+}
+
+/// Simulated time rounded to a nanosecond (summed steps carry rounding noise).
+fn round_time(t: f64) -> f64 {
+    (t * 1e9).round() / 1e9
+}
+
+/// Drop frames holding a non-finite coordinate (and every frame after one): the outputs stop
+/// at the last good frame.
+fn trim_non_finite(sim: &mut Simulated) {
+    let bad = sim
+        .cloth
+        .frames
+        .iter()
+        .position(|f| f.iter().flatten().any(|v| !v.is_finite()));
+    if let Some(k) = bad {
+        let k = k.max(1);
+        sim.cloth.frames.truncate(k);
+        sim.cloth.times.truncate(k);
+        sim.warnings.push(format!(
+            "frames from t = {:.3} s on hold non-finite positions and were dropped",
+            sim.cloth.times.last().copied().unwrap_or(0.0)
+        ));
+        if sim.failure.is_none() {
+            sim.failure = Some("non-finite positions".into());
+        }
+    }
+}
+
+fn to_y_up(p: &Vector3<f64>) -> [f64; 3] {
+    [p.x, p.z, -p.y]
+}
+
+fn add_timings(sum: &mut StageTimings, t: &StageTimings) {
+    sum.bending += t.bending;
+    sum.internal += t.internal;
+    sum.velocity += t.velocity;
+    sum.shape += t.shape;
+    sum.collision += t.collision;
+    sum.transfer += t.transfer;
+    sum.update += t.update;
+}
+
+fn garment(
+    spec: &crate::pipeline::GarmentSpec,
+    base: &Path,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulated, RunError> {
+    let run = run_garment(spec, base, progress).map_err(|e| RunError::Setup(e.to_string()))?;
+    let mut cloth = Animation::default();
+    let mut body = Animation::default();
+    for f in &run.frames {
+        cloth.push(f.time, f.cloth.clone());
+        body.push(f.time, f.body.clone());
+    }
+    let body_moves = body.frames.iter().any(|f| *f != body.frames[0]);
+    if !body_moves {
+        body = Animation::still(body.frames[0].clone());
+    }
+    let last = run.frames.last().map(|f| f.time).unwrap_or(0.0);
+    let lowest = run
+        .frames
+        .last()
+        .map(|f| f.cloth.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min));
+    let mut metrics = BTreeMap::new();
+    let mut put = |k: &str, v: Option<f64>| {
+        metrics.insert(k.to_string(), v);
+    };
+    put("body_triangles", Some(run.body_triangles.len() as f64));
+    put("pairs", Some(run.pairs.1 as f64));
+    put("pairs_sewn", Some(run.pairs.0 as f64));
+    put(
+        "unsewn_pairs",
+        Some(run.pairs.1.saturating_sub(run.pairs.0) as f64),
+    );
+    put("sewn_at_s", run.sewn_at.map(round_time));
+    put("max_penetration_m", Some(run.max_penetration));
+    put("max_strain_error", Some(run.max_strain_error.0));
+    put("final_strain_error", Some(run.max_strain_error.1));
+    put("kinetic_energy_j", Some(run.kinetic_energy));
+    put("lowest_node_m", lowest);
+    Ok(Simulated {
+        fabric: String::new(),
+        cloth_triangles: run.cloth_triangles,
+        cloth,
+        solid: Some(Solid {
+            name: "body",
+            triangles: run.body_triangles,
+            motion: body,
+        }),
+        steps: run.steps,
+        dt: spec.dt,
+        simulated: last,
+        wall_seconds: run.wall_seconds,
+        timings: run.timings,
+        metrics,
+        warnings: run.warnings,
+        failure: run.failure,
+    })
+}
+
+/// A stepping loop shared by the validation scenes: steps `state` until `done` says so (or a
+/// step fails), records a frame every `interval` and keeps the last good positions.
+struct Stepper {
+    frames: Animation,
+    interval: f64,
+    next_frame: f64,
+    steps: usize,
+    wall: Duration,
+    timings: StageTimings,
+    max_strain_error: f64,
+    max_speed: f64,
+    failure: Option<String>,
+    last_good: Vec<Vector3<f64>>,
+}
+
+impl Stepper {
+    fn new(state: &ClothState, interval: f64) -> Self {
+        let mut frames = Animation::default();
+        frames.push(state.time, state.positions.iter().map(to_y_up).collect());
+        Self {
+            frames,
+            interval,
+            next_frame: state.time + interval,
+            steps: 0,
+            wall: Duration::ZERO,
+            timings: StageTimings::default(),
+            max_strain_error: 0.0,
+            max_speed: 0.0,
+            failure: None,
+            last_good: state.positions.clone(),
+        }
+    }
+
+    /// One step; false when it failed (the state is then restored to the last good positions).
+    fn step(
+        &mut self,
+        solver: &mut Solver,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &StepParams,
+    ) -> bool {
+        self.last_good.copy_from_slice(&state.positions);
+        let t = state.time;
+        let clock = Instant::now();
+        let result = solver.step(cloth, state, params);
+        self.wall += clock.elapsed();
+        match result {
+            Ok(r) => {
+                self.steps += 1;
+                add_timings(&mut self.timings, &r.timings);
+                self.max_strain_error = self.max_strain_error.max(r.max_strain_error);
+                self.max_speed = r.max_speed;
+                if state.time + 1e-9 * params.dt >= self.next_frame {
+                    self.frames
+                        .push(state.time, state.positions.iter().map(to_y_up).collect());
+                    self.next_frame += self.interval;
+                }
+                true
+            }
+            Err(e) => {
+                self.failure = Some(format!("step at time {t:.4} s: {e}"));
+                state.positions.copy_from_slice(&self.last_good);
+                state.time = t;
+                false
+            }
+        }
+    }
+
+    /// Record the final state unless it is the last frame already.
+    fn finish(&mut self, state: &ClothState) {
+        if self
+            .frames
+            .times
+            .last()
+            .is_none_or(|&t| state.time > t + 1e-12)
+        {
+            self.frames
+                .push(state.time, state.positions.iter().map(to_y_up).collect());
+        }
+    }
+
+    fn into_simulated(
+        self,
+        cloth: &Cloth,
+        state: &ClothState,
+        dt: f64,
+        solid: Option<Solid>,
+        mut metrics: BTreeMap<String, Option<f64>>,
+    ) -> Simulated {
+        metrics.insert("max_strain_error".into(), Some(self.max_strain_error));
+        let ke = if self.failure.is_some() {
+            None
+        } else {
+            Some(state.kinetic_energy(cloth))
+        };
+        metrics.insert("kinetic_energy_j".into(), ke);
+        Simulated {
+            fabric: String::new(),
+            cloth_triangles: cloth.topology().triangles().to_vec(),
+            cloth: self.frames,
+            solid,
+            steps: self.steps,
+            dt,
+            simulated: state.time,
+            wall_seconds: self.wall.as_secs_f64(),
+            timings: self.timings,
+            metrics,
+            warnings: Vec::new(),
+            failure: self.failure,
+        }
+    }
+}
+
+/// RMS speed of the free nodes, mass-weighted, m/s (the drape's rest test).
+fn rms_speed(cloth: &Cloth, state: &ClothState) -> f64 {
+    let (mut e, mut m) = (0.0, 0.0);
+    for (i, (v, mass)) in state.velocities.iter().zip(cloth.masses()).enumerate() {
+        if !cloth.is_pinned(i) {
+            e += mass * v.norm_squared();
+            m += mass;
+        }
+    }
+    if m > 0.0 { (e / m).sqrt() } else { 0.0 }
+}
+
+fn drape(
+    spec: &DrapeSpec,
+    fabric: &Fabric,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulated, RunError> {
+    let (preset, dt) = match spec.tester {
+        Tester::Jis => (DrapeScene::jis(72, 8), 1e-3),
+        Tester::Thesis => (DrapeScene::thesis(), 2.5e-3),
+    };
+    let mut scene = DrapeScene {
+        n_around: spec.n_around.unwrap_or(preset.n_around),
+        n_rings: spec.n_rings.unwrap_or(preset.n_rings),
+        perturbation: spec.perturbation,
+        seed: spec.seed,
+        ..preset
+    };
+    scene.cloth_options.form = spec.form;
+    let (cloth, mut state) = scene
+        .build(fabric)
+        .map_err(|e| RunError::Setup(format!("drape scene: {e}")))?;
+    let params = StepParams {
+        dt: spec.dt.unwrap_or(dt),
+        ..spec.step.clone()
+    };
+    params
+        .validate()
+        .map_err(|e| RunError::Setup(format!("drape scene: {e}")))?;
+    // The rest criterion of `run_drape` (RestCriterion::default()).
+    let stop = atelier_solver::scenes::RestCriterion::default();
+    let eps = 1e-9 * params.dt;
+    let mut stepper = Stepper::new(&state, spec.frame_interval);
+    let mut solver = Solver::new();
+    let mut below_since: Option<f64> = None;
+    let mut settled = false;
+    while state.time < spec.max_time - eps {
+        if !stepper.step(&mut solver, &cloth, &mut state, &params) {
+            break;
+        }
+        progress(state.time / spec.max_time);
+        if spec.until_rest {
+            if rms_speed(&cloth, &state) < stop.rest_speed {
+                let since = *below_since.get_or_insert(state.time);
+                if state.time >= stop.min_time - eps && state.time - since >= stop.hold_time - eps {
+                    settled = true;
+                    break;
+                }
+            } else {
+                below_since = None;
+            }
+        }
+    }
+    stepper.finish(&state);
+    let mut metrics = BTreeMap::new();
+    let ok = stepper.failure.is_none();
+    let m = scene.measure(&cloth, &state);
+    let mut put = |k: &str, v: f64| {
+        metrics.insert(k.to_string(), ok.then_some(v));
+    };
+    put("drape_coefficient_percent", m.drape_coefficient);
+    put("node_count", m.nodes as f64);
+    put("shadow_area_m2", m.shadow_area);
+    put("settled", if settled { 1.0 } else { 0.0 });
+    put("rms_speed_m_s", rms_speed(&cloth, &state));
+    put("min_edge_radius_m", m.min_edge_radius);
+    put("max_edge_radius_m", m.max_edge_radius);
+    let mut warnings = Vec::new();
+    if spec.until_rest && !settled && ok {
+        warnings.push(format!(
+            "not at rest after {:.2} s: measured at the time cap",
+            spec.max_time
+        ));
+    }
+    let support = support_stand(
+        scene.support_radius(),
+        1.2 * (scene.specimen_radius() - scene.support_radius()),
+    );
+    let mut sim = stepper.into_simulated(&cloth, &state, params.dt, Some(support), metrics);
+    sim.warnings.extend(warnings);
+    Ok(sim)
+}
+
+/// The drape tester's support: a closed cylinder of the support's radius and height `depth`
+/// under the specimen, top at z = 0 (y-up frame in the outputs).
+fn support_stand(radius: f64, depth: f64) -> Solid {
+    let n = 48;
+    let mut v: Vec<[f64; 3]> = Vec::new();
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        let (x, y) = (radius * a.cos(), radius * a.sin());
+        v.push(to_y_up(&Vector3::new(x, y, 0.0)));
+        v.push(to_y_up(&Vector3::new(x, y, -depth)));
+    }
+    let top = v.len() as u32;
+    v.push(to_y_up(&Vector3::new(0.0, 0.0, 0.0)));
+    let bottom = top + 1;
+    v.push(to_y_up(&Vector3::new(0.0, 0.0, -depth)));
+    let mut t = Vec::new();
+    for k in 0..n as u32 {
+        let j = (k + 1) % n as u32;
+        let (a0, a1, b0, b1) = (2 * k, 2 * k + 1, 2 * j, 2 * j + 1);
+        // In the z-up frame counter-clockwise about +z; the map to y up is a rotation.
+        t.push([a0, a1, b1]);
+        t.push([a0, b1, b0]);
+        t.push([top, a0, b0]);
+        t.push([bottom, b1, a1]);
+    }
+    Solid {
+        name: "support",
+        triangles: t,
+        motion: Animation::still(v),
+    }
+}
+
+/// An axis-aligned box (z-up frame), outward triangles.
+fn block(lo: [f64; 3], hi: [f64; 3], name: &'static str) -> Solid {
+    let mut v = Vec::new();
+    for k in 0..8 {
+        let p = Vector3::new(
+            if k & 1 == 0 { lo[0] } else { hi[0] },
+            if k & 2 == 0 { lo[1] } else { hi[1] },
+            if k & 4 == 0 { lo[2] } else { hi[2] },
+        );
+        v.push(to_y_up(&p));
+    }
+    // Faces as quads (outward, counter-clockwise seen from outside).
+    let quads = [
+        [0, 2, 3, 1], // z lo
+        [4, 5, 7, 6], // z hi
+        [0, 1, 5, 4], // y lo
+        [2, 6, 7, 3], // y hi
+        [0, 4, 6, 2], // x lo
+        [1, 3, 7, 5], // x hi
+    ];
+    let mut t = Vec::new();
+    for q in quads {
+        t.push([q[0], q[1], q[2]]);
+        t.push([q[0], q[2], q[3]]);
+    }
+    Solid {
+        name,
+        triangles: t,
+        motion: Animation::still(v),
+    }
+}
+
+/// The Peirce cantilever: the strip of `segments` cells along its direction, two nodes (1 cm)
+/// wide, clamped by two rows of pinned nodes at ±h/2 about the platform edge x = 0, its tip at
+/// x = overhang; run until every node is slower than 5 mm/s after 1.5 s (or the time cap).
+/// The chord angle from the edge to the tip is compared with the elastica's 41.5° (exact at the
+/// default overhang 2.0003·c).
+fn cantilever(
+    spec: &CantileverSpec,
+    fabric: &Fabric,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulated, RunError> {
+    let rigidity = match spec.direction {
+        StripDirection::Warp => fabric.bending.warp.rigidity(),
+        StripDirection::Weft => fabric.bending.weft.rigidity(),
+    };
+    let c = (rigidity / fabric.weight_per_area()).cbrt();
+    let length = spec.overhang.unwrap_or(2.0003 * c);
+    let segments = spec.segments;
+    let h = length / (segments as f64 + 0.5);
+    let width = 0.01;
+    let nv = segments + 2;
+    let mut grid = StructuredGrid::sheet(2, nv, width, (nv - 1) as f64 * h);
+    if spec.direction == StripDirection::Weft {
+        // Warp across the strip (along pattern x): the strip runs along the weft.
+        grid.grain_angle = 0.0;
+    }
+    let setup = |e: String| RunError::Setup(format!("cantilever: {e}"));
+    let topo = ClothTopology::from_structured(&grid).map_err(|e| setup(e.to_string()))?;
+    let mut cloth =
+        Cloth::new(topo, fabric, AnisotropyForm::Thesis).map_err(|e| setup(e.to_string()))?;
+    let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
+    for node in 0..4 {
+        let p = place(cloth.topology().rest_positions()[node]);
+        cloth
+            .pin(node as u32, p, PinMotion::Fixed)
+            .map_err(|e| setup(e.to_string()))?;
+    }
+    let mut state = ClothState::placed(&cloth, place);
+    // Implicit bending keeps this stable up to about 0.4·h s/m; 0.25·h leaves a margin.
+    let params = StepParams {
+        dt: 0.25 * h,
+        damping: spec.damping,
+        hysteresis: spec.hysteresis,
+        ..StepParams::default()
+    };
+    params.validate().map_err(|e| setup(e.to_string()))?;
+    let mut stepper = Stepper::new(&state, spec.frame_interval);
+    let mut solver = Solver::new();
+    let mut at_rest = false;
+    while state.time < spec.max_time {
+        if !stepper.step(&mut solver, &cloth, &mut state, &params) {
+            break;
+        }
+        progress(state.time / spec.max_time);
+        if state.time > 1.5 && stepper.max_speed < 5e-3 {
+            at_rest = true;
+            break;
+        }
+    }
+    stepper.finish(&state);
+    let tip = (state.positions[2 * (nv - 1)] + state.positions[2 * (nv - 1) + 1]) * 0.5;
+    let angle = (-tip.z).atan2(tip.x).to_degrees();
+    let ok = stepper.failure.is_none();
+    let mut metrics = BTreeMap::new();
+    metrics.insert("bending_length_m".into(), Some(c));
+    metrics.insert("overhang_m".into(), Some(length));
+    metrics.insert("chord_angle_deg".into(), ok.then_some(angle));
+    let reference = (spec.overhang.is_none()).then_some(41.5);
+    metrics.insert(
+        "chord_angle_error_deg".into(),
+        reference.filter(|_| ok).map(|r| angle - r),
+    );
+    metrics.insert("tip_droop_m".into(), ok.then_some(-tip.z));
+    metrics.insert("max_speed_m_s".into(), ok.then_some(stepper.max_speed));
+    let platform = block([-0.1, -0.01, -0.02], [0.0, width + 0.01, 0.0], "platform");
+    let mut sim = stepper.into_simulated(&cloth, &state, params.dt, Some(platform), metrics);
+    if !at_rest && ok {
+        sim.warnings.push(format!(
+            "not at rest after {:.2} s (fastest node {:.2e} m/s)",
+            spec.max_time,
+            sim.metrics
+                .get("max_speed_m_s")
+                .copied()
+                .flatten()
+                .unwrap_or(f64::NAN)
+        ));
+    }
+    Ok(sim)
+}
+
+/// The inextensible catenary with span `d` and length `l`: the parameter a of
+/// l = 2a·sinh(d/2a), by bisection.
+fn catenary_parameter(d: f64, l: f64) -> f64 {
+    let (mut lo, mut hi): (f64, f64) = (1e-4, 1e4);
+    for _ in 0..200 {
+        let a = (lo * hi).sqrt();
+        if 2.0 * a * (d / (2.0 * a)).sinh() > l {
+            lo = a
+        } else {
+            hi = a
+        }
+    }
+    (lo * hi).sqrt()
+}
+
+/// A strip two nodes (1 cm) wide hung from both ends, bending off, started on a circular arc of
+/// its own length through both supports; compared at the end with the inextensible catenary
+/// z = a(cosh(x/a) − cosh(d/2a)).
+fn catenary(
+    spec: &CatenarySpec,
+    fabric: &Fabric,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulated, RunError> {
+    let (length, span, segments) = (spec.length, spec.span, spec.segments);
+    let setup = |e: String| RunError::Setup(format!("catenary: {e}"));
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(segments + 1, 2, length, 0.01))
+            .map_err(|e| setup(e.to_string()))?;
+    let mut cloth =
+        Cloth::new(topo, fabric, AnisotropyForm::Thesis).map_err(|e| setup(e.to_string()))?;
+    let a = catenary_parameter(span, length);
+    let (mut lo, mut hi) = (1e-6_f64, std::f64::consts::PI - 1e-9);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if span / (2.0 * mid.sin()) * 2.0 * mid > length {
+            hi = mid
+        } else {
+            lo = mid
+        }
+    }
+    let half = 0.5 * (lo + hi);
+    let radius = span / (2.0 * half.sin());
+    let place = |[x, y]: [f64; 2]| {
+        let phi = -half + 2.0 * half * x / length;
+        Vector3::new(radius * phi.sin(), y, -radius * (phi.cos() - half.cos()))
+    };
+    let n_u = segments + 1;
+    for j in 0..2 {
+        for i in [0, segments] {
+            let node = j * n_u + i;
+            let p = place(cloth.topology().rest_positions()[node]);
+            cloth
+                .pin(node as u32, p, PinMotion::Fixed)
+                .map_err(|e| setup(e.to_string()))?;
+        }
+    }
+    let mut state = ClothState::placed(&cloth, place);
+    let params = StepParams {
+        dt: spec.dt,
+        damping: spec.damping,
+        bending_off: true,
+        ..StepParams::default()
+    };
+    params.validate().map_err(|e| setup(e.to_string()))?;
+    let mut stepper = Stepper::new(&state, spec.frame_interval);
+    let mut solver = Solver::new();
+    let steps = (spec.duration / spec.dt).round() as usize;
+    for _ in 0..steps {
+        if !stepper.step(&mut solver, &cloth, &mut state, &params) {
+            break;
+        }
+        progress(state.time / spec.duration);
+    }
+    stepper.finish(&state);
+    let ok = stepper.failure.is_none();
+    let mut worst: f64 = 0.0;
+    for p in &state.positions {
+        let exact = a * ((p.x / a).cosh() - (span / (2.0 * a)).cosh());
+        worst = worst.max((p.z - exact).abs());
+    }
+    let sag = -state
+        .positions
+        .iter()
+        .map(|p| p.z)
+        .fold(f64::INFINITY, f64::min);
+    let mut metrics = BTreeMap::new();
+    metrics.insert("catenary_parameter_m".into(), Some(a));
+    metrics.insert("max_deviation_m".into(), ok.then_some(worst));
+    metrics.insert(
+        "max_deviation_percent_span".into(),
+        ok.then_some(100.0 * worst / span),
+    );
+    metrics.insert("sag_m".into(), ok.then_some(sag));
+    metrics.insert("max_speed_m_s".into(), ok.then_some(stepper.max_speed));
+    Ok(stepper.into_simulated(&cloth, &state, params.dt, None, metrics))
+}
+
+/// The folder relative paths of a scenario file are resolved against: the file's own folder.
+pub fn base_of(file: &Path) -> PathBuf {
+    file.parent()
+        .map(Path::to_path_buf)
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or_else(|| PathBuf::from("."))
+}

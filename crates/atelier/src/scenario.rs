@@ -1,0 +1,568 @@
+//! Scenario files: one RON file per run, naming what it reproduces, the kind of scene (a garment
+//! sewn on a body and worn, a drape test, a cantilever, a catenary) and, optionally, the bounds
+//! its metrics must meet. `atelier run SCENARIO.ron` runs one ([`crate::run`]); the format is
+//! documented in `docs/report.md` beside the report it produces.
+//!
+//! ```ron
+//! (
+//!     name: "drape_jis_cotton_broad",
+//!     reproduces: "JIS L 1096 drape test of cotton broad (Matsudaira et al. 2015: DC 82.9 %)",
+//!     kind: Drape(fabric: "../fabrics/cotton_broad.ron", tester: Jis),
+//!     expectations: [(metric: "drape_coefficient_percent", min: 74.9, max: 90.9)],
+//! )
+//! ```
+//!
+//! Relative paths inside a scenario are resolved against the scenario file's folder. Unknown
+//! fields are rejected; every error names the file, line:column and field.
+
+use std::path::{Path, PathBuf};
+
+use atelier_fabric::{AnisotropyForm, ErrorKind, FileError, InvalidValue};
+use atelier_solver::StepParams;
+use serde::{Deserialize, Serialize};
+
+use crate::pipeline::GarmentSpec;
+
+/// One scenario file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name (letters, digits, `_` and `-`): the output folder of `cargo xtask
+    /// run-scenarios` and the row of its summary.
+    pub name: String,
+    /// What the scenario reproduces: the test, figure or claim, with its source (required).
+    pub reproduces: String,
+    /// The scene.
+    pub kind: ScenarioKind,
+    /// Bounds on metrics the runner checks (none by default).
+    #[serde(default)]
+    pub expectations: Vec<Expectation>,
+}
+
+/// The scene a scenario runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ScenarioKind {
+    /// A garment placed around a body, sewn with gravity off, settled, then worn while the body
+    /// moves ([`crate::pipeline`]).
+    Garment(GarmentSpec),
+    /// The drape test: a circular specimen falling onto a circular support
+    /// ([`atelier_solver::scenes::DrapeScene`]).
+    Drape(DrapeSpec),
+    /// The Peirce cantilever (ASTM D1388, JIS L 1096): a strip overhanging a platform droops to a
+    /// chord angle of 41.5° at the overhang 2.0003·c, c = (B/w)^(1/3).
+    Cantilever(CantileverSpec),
+    /// A strip hung from both ends, bending off, against the inextensible catenary.
+    Catenary(CatenarySpec),
+}
+
+impl ScenarioKind {
+    /// Name of the kind (`Garment`, `Drape`, …), as written in the file.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ScenarioKind::Garment(_) => "Garment",
+            ScenarioKind::Drape(_) => "Drape",
+            ScenarioKind::Cantilever(_) => "Cantilever",
+            ScenarioKind::Catenary(_) => "Catenary",
+        }
+    }
+
+    /// The fabric file the scene uses.
+    pub fn fabric(&self) -> &Path {
+        match self {
+            ScenarioKind::Garment(s) => &s.fabric,
+            ScenarioKind::Drape(s) => &s.fabric,
+            ScenarioKind::Cantilever(s) => &s.fabric,
+            ScenarioKind::Catenary(s) => &s.fabric,
+        }
+    }
+
+    /// The metrics a run of this kind reports (the names expectations may use). Units are in the
+    /// names; `docs/report.md` defines each.
+    pub fn metric_names(&self) -> &'static [&'static str] {
+        match self {
+            ScenarioKind::Garment(_) => &[
+                "nodes",
+                "cloth_triangles",
+                "body_triangles",
+                "pairs",
+                "pairs_sewn",
+                "unsewn_pairs",
+                "sewn_at_s",
+                "simulated_s",
+                "max_penetration_m",
+                "max_strain_error",
+                "final_strain_error",
+                "kinetic_energy_j",
+                "lowest_node_m",
+                "frames",
+            ],
+            ScenarioKind::Drape(_) => &[
+                "nodes",
+                "cloth_triangles",
+                "simulated_s",
+                "drape_coefficient_percent",
+                "node_count",
+                "shadow_area_m2",
+                "settled",
+                "rms_speed_m_s",
+                "min_edge_radius_m",
+                "max_edge_radius_m",
+                "max_strain_error",
+                "kinetic_energy_j",
+                "frames",
+            ],
+            ScenarioKind::Cantilever(_) => &[
+                "nodes",
+                "cloth_triangles",
+                "simulated_s",
+                "bending_length_m",
+                "overhang_m",
+                "chord_angle_deg",
+                "chord_angle_error_deg",
+                "tip_droop_m",
+                "max_speed_m_s",
+                "max_strain_error",
+                "kinetic_energy_j",
+                "frames",
+            ],
+            ScenarioKind::Catenary(_) => &[
+                "nodes",
+                "cloth_triangles",
+                "simulated_s",
+                "catenary_parameter_m",
+                "max_deviation_m",
+                "max_deviation_percent_span",
+                "sag_m",
+                "max_speed_m_s",
+                "max_strain_error",
+                "kinetic_energy_j",
+                "frames",
+            ],
+        }
+    }
+}
+
+/// A bound on one metric: `min ≤ value ≤ max` (either may be left out, not both).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Expectation {
+    /// Metric name (see [`ScenarioKind::metric_names`]).
+    pub metric: String,
+    /// Smallest value accepted.
+    #[serde(default)]
+    pub min: Option<f64>,
+    /// Largest value accepted.
+    #[serde(default)]
+    pub max: Option<f64>,
+}
+
+impl Expectation {
+    /// Whether `value` meets the bound (a missing or NaN value never does).
+    pub fn met_by(&self, value: Option<f64>) -> bool {
+        value.is_some_and(|v| {
+            !v.is_nan() && self.min.is_none_or(|m| v >= m) && self.max.is_none_or(|m| v <= m)
+        })
+    }
+}
+
+/// The drape tester's geometry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Tester {
+    /// JIS L 1096: Ø 25.4 cm specimen on a Ø 12.7 cm support; default grid 72 × 8 nodes, Δt 1 ms.
+    Jis,
+    /// The thesis §3.9.3: Ø 63.5 cm with a Ø 12.7 cm hole; default grid 60 × 6 nodes, Δt 2.5 ms.
+    Thesis,
+}
+
+/// A drape test.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DrapeSpec {
+    /// Fabric file (RON).
+    pub fabric: PathBuf,
+    /// Tester geometry.
+    pub tester: Tester,
+    /// Nodes around each ring (default: 72 JIS, 60 thesis).
+    #[serde(default)]
+    pub n_around: Option<usize>,
+    /// Rings of nodes from the support's rim to the edge (default: 8 JIS, 6 thesis).
+    #[serde(default)]
+    pub n_rings: Option<usize>,
+    /// Time step, s (default: 0.001 JIS, 0.0025 thesis: the largest at which the rim ring does
+    /// not chatter, `docs/validation.md`).
+    #[serde(default)]
+    pub dt: Option<f64>,
+    /// Longest simulated time, s. Default 5.
+    #[serde(default = "default_drape_time")]
+    pub max_time: f64,
+    /// Stop once at rest (RMS speed of the free nodes below 5 mm/s for 0.2 s, after 0.5 s), as
+    /// `run_drape`'s default rest criterion; false: run `max_time`. Default true.
+    #[serde(default = "yes")]
+    pub until_rest: bool,
+    /// Seeded vertical perturbation of the free nodes at the start, m. Default 1e-4.
+    #[serde(default = "default_perturbation")]
+    pub perturbation: f64,
+    /// Seed of the perturbation. Default 1.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Anisotropy form. Default `Compliance` (the drape tests' choice, `docs/validation.md`).
+    #[serde(default = "default_drape_form")]
+    pub form: AnisotropyForm,
+    /// Interval between recorded frames, s. Default 0.04.
+    #[serde(default = "default_frame_interval")]
+    pub frame_interval: f64,
+    /// Overrides of the solver's step parameters (Δt is set by `dt`; gravity −z).
+    #[serde(default)]
+    pub step: StepParams,
+}
+
+/// The grain direction along a strip.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StripDirection {
+    /// The strip runs along the warp.
+    #[default]
+    Warp,
+    /// The strip runs along the weft.
+    Weft,
+}
+
+/// The Peirce cantilever.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CantileverSpec {
+    /// Fabric file (RON).
+    pub fabric: PathBuf,
+    /// Direction of the strip. Default `Warp`.
+    #[serde(default)]
+    pub direction: StripDirection,
+    /// Cells along the overhang (≥ 4). Default 40.
+    #[serde(default = "default_segments")]
+    pub segments: usize,
+    /// Overhang, m; default 2.0003·c with c = (B/w)^(1/3) of the strip's direction, the length
+    /// at which the exact heavy elastica's chord makes 41.5°.
+    #[serde(default)]
+    pub overhang: Option<f64>,
+    /// Damping c/S, kg/(m²·s). Default 1.
+    #[serde(default = "one")]
+    pub damping: f64,
+    /// Bending hysteresis on. Default false (the elastica is elastic).
+    #[serde(default)]
+    pub hysteresis: bool,
+    /// Longest simulated time, s; the run stops earlier once every node is slower than 5 mm/s
+    /// after 1.5 s. Default 6.
+    #[serde(default = "default_cantilever_time")]
+    pub max_time: f64,
+    /// Interval between recorded frames, s. Default 0.04.
+    #[serde(default = "default_frame_interval")]
+    pub frame_interval: f64,
+}
+
+/// A strip hung from both ends.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CatenarySpec {
+    /// Fabric file (RON).
+    pub fabric: PathBuf,
+    /// Strip length, m. Default 1.
+    #[serde(default = "one")]
+    pub length: f64,
+    /// Distance between the supports, m (less than the length). Default 0.8.
+    #[serde(default = "default_span")]
+    pub span: f64,
+    /// Cells along the strip. Default 50.
+    #[serde(default = "default_catenary_segments")]
+    pub segments: usize,
+    /// Time step, s. Default 0.005.
+    #[serde(default = "default_catenary_dt")]
+    pub dt: f64,
+    /// Simulated time, s. Default 10.
+    #[serde(default = "default_catenary_time")]
+    pub duration: f64,
+    /// Damping c/S, kg/(m²·s). Default 2.
+    #[serde(default = "two")]
+    pub damping: f64,
+    /// Interval between recorded frames, s. Default 0.04.
+    #[serde(default = "default_frame_interval")]
+    pub frame_interval: f64,
+}
+
+fn yes() -> bool {
+    true
+}
+fn one() -> f64 {
+    1.0
+}
+fn two() -> f64 {
+    2.0
+}
+fn default_drape_time() -> f64 {
+    5.0
+}
+fn default_perturbation() -> f64 {
+    1e-4
+}
+fn default_seed() -> u64 {
+    1
+}
+fn default_drape_form() -> AnisotropyForm {
+    AnisotropyForm::Compliance
+}
+fn default_frame_interval() -> f64 {
+    0.04
+}
+fn default_segments() -> usize {
+    40
+}
+fn default_cantilever_time() -> f64 {
+    6.0
+}
+fn default_span() -> f64 {
+    0.8
+}
+fn default_catenary_segments() -> usize {
+    50
+}
+fn default_catenary_dt() -> f64 {
+    0.005
+}
+fn default_catenary_time() -> f64 {
+    10.0
+}
+
+impl Scenario {
+    /// Read and check a scenario file.
+    pub fn load(path: &Path) -> Result<Self, FileError> {
+        let s: Scenario = atelier_fabric::files::load_ron(path)?;
+        s.check().map_err(|e| FileError::from_invalid(path, e))?;
+        Ok(s)
+    }
+
+    /// Parse and check scenario text; `file` names it in errors.
+    pub fn parse(text: &str, file: &Path) -> Result<Self, FileError> {
+        let s: Scenario = atelier_fabric::files::parse_ron(text, file)?;
+        s.check().map_err(|e| FileError::from_invalid(file, e))?;
+        Ok(s)
+    }
+
+    /// The files the scenario names (resolved against `base`) exist and are files.
+    pub fn check_files(&self, base: &Path) -> Result<(), InvalidValue> {
+        let mut files: Vec<(&str, &Path)> = vec![("kind.fabric", self.kind.fabric())];
+        if let ScenarioKind::Garment(g) = &self.kind {
+            files.push(("kind.garment", &g.garment));
+            if let Some(b) = &g.body {
+                files.push(("kind.body", b));
+            }
+            if let Some(m) = &g.motion {
+                files.push(("kind.motion", m));
+            }
+        }
+        for (field, f) in files {
+            let path = base.join(f);
+            if !path.is_file() {
+                return Err(InvalidValue::new(
+                    ErrorKind::Io,
+                    field,
+                    format!("{} is not a readable file", path.display()),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The checks serde cannot make: a usable name, a stated purpose, ranges, metric names.
+    /// (Garment scene ranges are checked by the pipeline when it starts.)
+    pub fn check(&self) -> Result<(), InvalidValue> {
+        let bad = |field: &str, kind: ErrorKind, message: String| {
+            Err(InvalidValue::new(kind, field, message))
+        };
+        if self.name.is_empty()
+            || !self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        {
+            return bad(
+                "name",
+                ErrorKind::OutOfRange,
+                format!(
+                    "`{}`: use letters, digits, `_` and `-` only (it names a folder)",
+                    self.name
+                ),
+            );
+        }
+        if self.reproduces.trim().is_empty() {
+            return bad(
+                "reproduces",
+                ErrorKind::MissingField,
+                "say what the scenario reproduces".into(),
+            );
+        }
+        let positive = |field: &str, v: f64| -> Result<(), InvalidValue> {
+            if !v.is_finite() {
+                bad(field, ErrorKind::NotFinite, format!("{v}"))
+            } else if v <= 0.0 {
+                bad(field, ErrorKind::OutOfRange, format!("{v} must be > 0"))
+            } else {
+                Ok(())
+            }
+        };
+        match &self.kind {
+            ScenarioKind::Garment(_) => {}
+            ScenarioKind::Drape(d) => {
+                if let Some(dt) = d.dt {
+                    positive("kind.dt", dt)?;
+                }
+                positive("kind.max_time", d.max_time)?;
+                positive("kind.frame_interval", d.frame_interval)?;
+                if !(d.perturbation >= 0.0 && d.perturbation.is_finite()) {
+                    return bad(
+                        "kind.perturbation",
+                        ErrorKind::OutOfRange,
+                        format!("{} must be finite and ≥ 0", d.perturbation),
+                    );
+                }
+                if d.n_around.is_some_and(|n| n < 3) || d.n_rings.is_some_and(|n| n < 2) {
+                    return bad(
+                        "kind.n_around",
+                        ErrorKind::OutOfRange,
+                        "need at least 3 nodes around and 2 rings".into(),
+                    );
+                }
+            }
+            ScenarioKind::Cantilever(c) => {
+                if c.segments < 4 {
+                    return bad(
+                        "kind.segments",
+                        ErrorKind::OutOfRange,
+                        format!("{} cells: use at least 4", c.segments),
+                    );
+                }
+                if let Some(l) = c.overhang {
+                    positive("kind.overhang", l)?;
+                }
+                positive("kind.damping", c.damping)?;
+                positive("kind.max_time", c.max_time)?;
+                positive("kind.frame_interval", c.frame_interval)?;
+            }
+            ScenarioKind::Catenary(c) => {
+                positive("kind.length", c.length)?;
+                positive("kind.span", c.span)?;
+                if c.span >= c.length {
+                    return bad(
+                        "kind.span",
+                        ErrorKind::Inconsistent,
+                        format!(
+                            "span {} m must be shorter than the strip ({} m)",
+                            c.span, c.length
+                        ),
+                    );
+                }
+                if c.segments < 4 {
+                    return bad(
+                        "kind.segments",
+                        ErrorKind::OutOfRange,
+                        format!("{} cells: use at least 4", c.segments),
+                    );
+                }
+                positive("kind.dt", c.dt)?;
+                positive("kind.duration", c.duration)?;
+                positive("kind.damping", c.damping)?;
+                positive("kind.frame_interval", c.frame_interval)?;
+            }
+        }
+        let names = self.kind.metric_names();
+        for (i, e) in self.expectations.iter().enumerate() {
+            let field = format!("expectations[{i}]");
+            if !names.contains(&e.metric.as_str()) {
+                return bad(
+                    &format!("{field}.metric"),
+                    ErrorKind::UnknownVariant,
+                    format!(
+                        "`{}` is not a metric of a {} scenario; expected one of {}",
+                        e.metric,
+                        self.kind.name(),
+                        names.join(", ")
+                    ),
+                );
+            }
+            if e.min.is_none() && e.max.is_none() {
+                return bad(
+                    &field,
+                    ErrorKind::MissingField,
+                    "give `min`, `max` or both".into(),
+                );
+            }
+            for (which, v) in [("min", e.min), ("max", e.max)] {
+                if v.is_some_and(f64::is_nan) {
+                    return bad(
+                        &format!("{field}.{which}"),
+                        ErrorKind::NotFinite,
+                        "NaN".into(),
+                    );
+                }
+            }
+            if let (Some(lo), Some(hi)) = (e.min, e.max)
+                && lo > hi
+            {
+                return bad(
+                    &field,
+                    ErrorKind::Inconsistent,
+                    format!("min {lo} > max {hi}"),
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Scenario, FileError> {
+        Scenario::parse(text, Path::new("test.ron"))
+    }
+
+    #[test]
+    fn a_drape_scenario_reads_with_its_defaults() {
+        let s = parse(
+            r#"(name: "d", reproduces: "JIS drape", kind: Drape(fabric: "f.ron", tester: Jis),
+                expectations: [(metric: "drape_coefficient_percent", min: 10.0)])"#,
+        )
+        .expect("parses");
+        let ScenarioKind::Drape(d) = &s.kind else {
+            panic!("kind")
+        };
+        assert_eq!(d.tester, Tester::Jis);
+        assert!(d.until_rest);
+        assert!(s.expectations[0].met_by(Some(12.0)));
+        assert!(!s.expectations[0].met_by(Some(9.0)));
+        assert!(!s.expectations[0].met_by(None));
+        assert!(!s.expectations[0].met_by(Some(f64::NAN)));
+    }
+
+    #[test]
+    fn errors_name_position_and_field() {
+        let e = parse(
+            "(name: \"d\", reproduces: \"x\",\n kind: Drape(fabric: \"f.ron\", tester: Jis, wobble: 3))",
+        )
+        .expect_err("unknown field");
+        assert_eq!(e.kind, ErrorKind::UnknownField);
+        assert_eq!(e.position.map(|p| p.line), Some(2));
+        assert!(e.to_string().contains("test.ron:2:"), "{e}");
+        assert!(e.field.contains("wobble"), "{e}");
+        let e = parse(r#"(name: "d", kind: Drape(fabric: "f.ron", tester: Jis))"#)
+            .expect_err("missing reproduces");
+        assert_eq!(e.kind, ErrorKind::MissingField);
+        assert!(e.field.contains("reproduces"), "{e}");
+        let e = parse(
+            r#"(name: "d", reproduces: "x", kind: Drape(fabric: "f.ron", tester: Jis),
+                expectations: [(metric: "chord_angle_deg", max: 1.0)])"#,
+        )
+        .expect_err("metric of another kind");
+        assert_eq!(e.field, "expectations[0].metric");
+        let e = parse(r#"(name: "a b", reproduces: "x", kind: Drape(fabric: "f", tester: Jis))"#)
+            .expect_err("bad name");
+        assert_eq!(e.field, "name");
+    }
+}
