@@ -9,6 +9,9 @@
 //!   images coloured by part and its error image.
 //! - `cargo xtask figures body [--out DIR]` — the mannequin at rest and walking (front and side),
 //!   the arm raise, and its range images with landmarks.
+//! - `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]` — every scenario of
+//!   `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on a full run
+//!   `docs/results.md` with its gallery; fails if a scenario fails or misses an expectation.
 
 mod figures_body;
 mod figures_fabric;
@@ -16,6 +19,7 @@ mod figures_grid;
 mod figures_grid_body;
 mod figures_solver;
 mod plot;
+mod run_scenarios;
 
 use std::path::{Path, PathBuf};
 
@@ -38,6 +42,20 @@ enum Command {
         /// Output folder (created if missing); default `figures/<set>` in the repository.
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Run the scenarios of fixtures/scenarios/: summary.json and summary.md in the output
+    /// folder; a full run regenerates docs/results.md. Fails if a scenario fails or misses an
+    /// expectation.
+    RunScenarios {
+        /// Run only these scenarios (file names without `.ron`).
+        #[arg(long, num_args = 1..)]
+        only: Vec<String>,
+        /// Output folder (created if missing); default `target/scenarios` in the repository.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Run shard I of N (1-based): every N-th scenario by name from the I-th.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<String>,
     },
 }
 
@@ -77,6 +95,18 @@ fn main() -> Result<()> {
             plot::register_font()?;
             for written in draw_all(&repository_root(), &out)? {
                 eprintln!("wrote {}", written.display());
+            }
+        }
+        Command::RunScenarios { only, out, shard } => {
+            let shard = shard
+                .as_deref()
+                .map(run_scenarios::parse_shard)
+                .transpose()?;
+            let root = repository_root();
+            let out = out.unwrap_or_else(|| root.join("target/scenarios"));
+            if !run_scenarios::run_all(&root, &only, &out, shard)? {
+                eprintln!("some scenarios failed or missed an expectation (see above)");
+                std::process::exit(1);
             }
         }
     }

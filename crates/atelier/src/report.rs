@@ -199,7 +199,13 @@ impl Report {
             .iter()
             .filter(|e| !e.met)
             .map(|e| {
-                let value = e.value.map_or("not measured".into(), |v| format!("{v:.4}"));
+                let value = e.value.map_or("not measured".into(), |v| {
+                    if v.fract() == 0.0 && v.abs() < 1e15 {
+                        format!("{v:.0}")
+                    } else {
+                        format!("{v:.4}")
+                    }
+                });
                 let bound = match (e.min, e.max) {
                     (Some(a), Some(b)) => format!("[{a}, {b}]"),
                     (Some(a), None) => format!("≥ {a}"),

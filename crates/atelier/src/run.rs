@@ -154,15 +154,27 @@ pub fn run(
         // The validation scenes are wider than tall: square views.
         options.picture.1 = options.picture.0;
     }
-    let (written, warnings) = write_outputs(&sim, out, &options, scenario_is_drape(scenario))?;
+    let style = match scenario.kind {
+        ScenarioKind::Garment(_) => PictureStyle::Plain,
+        ScenarioKind::Drape(_) => PictureStyle::WithTop,
+        ScenarioKind::Cantilever(_) | ScenarioKind::Catenary(_) => PictureStyle::Tilted,
+    };
+    let (written, warnings) = write_outputs(&sim, out, &options, style)?;
     report.outputs = written;
     report.warnings.extend(warnings);
     report.write(&out.join(outputs::REPORT))?;
     Ok(report)
 }
 
-fn scenario_is_drape(s: &Scenario) -> bool {
-    matches!(s.kind, ScenarioKind::Drape(_))
+/// How the final state is pictured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PictureStyle {
+    /// Front and side.
+    Plain,
+    /// Front and side, and a view from above (`top.png`).
+    WithTop,
+    /// Front and side of the scene tilted 35° about x (strips).
+    Tilted,
 }
 
 /// Create the output folder and remove temporary files a killed run may have left beside the
@@ -195,7 +207,7 @@ fn write_outputs(
     sim: &Simulated,
     out: &Path,
     options: &RunOptions,
-    top_view: bool,
+    style: PictureStyle,
 ) -> Result<(Vec<String>, Vec<String>), RunError> {
     let mut written = Vec::new();
     let mut warnings = Vec::new();
@@ -246,20 +258,29 @@ fn write_outputs(
     let solid_final = solid_part
         .as_ref()
         .and_then(|(_, s)| s.motion.last().map(|p| (p, s.triangles.as_slice())));
-    let pixels =
-        crate::picture::garment_views((final_cloth, &sim.cloth_triangles), solid_final, w, h);
+    let draw = |map: &dyn Fn(&[f64; 3]) -> [f64; 3], w: usize, h: usize| {
+        let cloth: Vec<[f64; 3]> = final_cloth.iter().map(map).collect();
+        let solid_points: Option<Vec<[f64; 3]>> =
+            solid_final.map(|(p, _)| p.iter().map(map).collect());
+        let solid = solid_points.as_deref().zip(solid_final.map(|(_, t)| t));
+        crate::picture::garment_views((&cloth, &sim.cloth_triangles), solid, w, h)
+    };
+    let pixels = match style {
+        // A strip is seen edge-on from the front: tilt it 35° about x (its top towards the
+        // camera) so that its droop and its surface both show.
+        PictureStyle::Tilted => {
+            let (s, c) = 35f64.to_radians().sin_cos();
+            draw(&|p| [p[0], p[1] * c - p[2] * s, p[1] * s + p[2] * c], w, h)
+        }
+        _ => draw(&|p| *p, w, h),
+    };
     let path = out.join(outputs::PICTURE);
     crate::picture::write_png(&path, &pixels, 2 * w, h, [1.0; 3])
         .map_err(|source| RunError::Output { path, source })?;
     written.push(outputs::PICTURE.into());
-    if top_view {
+    if style == PictureStyle::WithTop {
         // Seen from above: screen x = x, screen y = −z (forward is down), depth y.
-        let down = |p: &[f64; 3]| [p[0], -p[2], p[1]];
-        let cloth: Vec<[f64; 3]> = final_cloth.iter().map(down).collect();
-        let solid_points: Option<Vec<[f64; 3]>> =
-            solid_final.map(|(p, _)| p.iter().map(down).collect());
-        let solid = solid_points.as_deref().zip(solid_final.map(|(_, t)| t));
-        let pixels = crate::picture::garment_views((&cloth, &sim.cloth_triangles), solid, h, h);
+        let pixels = draw(&|p| [p[0], -p[2], p[1]], h, h);
         // Keep the left (front) half: the view from above.
         let mut top = Vec::with_capacity(h * h);
         for row in pixels.chunks(2 * h) {
@@ -771,7 +792,11 @@ fn cantilever(
     );
     metrics.insert("tip_droop_m".into(), ok.then_some(-tip.z));
     metrics.insert("max_speed_m_s".into(), ok.then_some(stepper.max_speed));
-    let platform = block([-0.1, -0.01, -0.02], [0.0, width + 0.01, 0.0], "platform");
+    let platform = block(
+        [-length, -0.01, -0.02],
+        [0.0, width + 0.01, 0.0],
+        "platform",
+    );
     let mut sim = stepper.into_simulated(&cloth, &state, params.dt, Some(platform), metrics);
     if !at_rest && ok {
         sim.warnings.push(format!(

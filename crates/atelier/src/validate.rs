@@ -77,6 +77,15 @@ pub fn validate(path: &Path) -> Outcome {
             },
         ));
     }
+    // A file that reads as a scenario is one: its later checks (ranges, metric names, the
+    // files it names) carry no position, so they must not lose to another format's parse error.
+    if let Ok(s) = atelier_fabric::files::load_ron::<crate::scenario::Scenario>(path) {
+        return s
+            .check()
+            .and_then(|()| s.check_files(&crate::run::base_of(path)))
+            .map(|()| Kind::Scenario)
+            .map_err(|e| (Some(Kind::Scenario), FileError::from_invalid(path, e)));
+    }
     let attempts: [(Kind, &Check); 7] = [
         (Kind::Fabric, &|p| {
             atelier_fabric::Fabric::load(p).map(|_| ())

@@ -1,6 +1,8 @@
-//! `atelier validate`: success, a bad file, a missing file — exit codes and one line per file.
+//! The `atelier` program: `validate` (success, a bad file, a missing file) and `run` (success,
+//! a bad file, a missing file, an unwritable folder, a diverging run, an interrupted run,
+//! determinism, the default scenario) — exit codes, one-line errors, the files written.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn root() -> PathBuf {
@@ -87,5 +89,364 @@ fn a_bad_file_is_reported_with_its_position_and_field_and_fails() {
         !err.contains("panicked") && !err.contains("backtrace"),
         "{err}"
     );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+// ---- atelier run -------------------------------------------------------------------------
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("atelier-cli-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn fabric_path() -> String {
+    root()
+        .join("fixtures/fabrics/cotton_broad.ron")
+        .canonicalize()
+        .expect("fixture")
+        .display()
+        .to_string()
+}
+
+/// A JIS drape on an `n × m` grid for `seconds` at Δt 2 ms, never stopping early.
+fn drape_scenario(n_around: usize, n_rings: usize, seconds: f64) -> String {
+    format!(
+        r#"(
+    name: "cli_drape",
+    reproduces: "a short JIS drape (CLI test)",
+    kind: Drape(fabric: "{}", tester: Jis, n_around: {n_around}, n_rings: {n_rings}, dt: 0.002,
+        max_time: {seconds}, until_rest: false),
+    expectations: [(metric: "drape_coefficient_percent", min: 0.0, max: 100.0)],
+)"#,
+        fabric_path()
+    )
+}
+
+/// The dress skirt sewn for 0.1 s (gravity never starts).
+fn skirt_scenario() -> String {
+    let r = root().canonicalize().expect("root");
+    format!(
+        r#"(
+    name: "cli_skirt",
+    reproduces: "the first steps of sewing the dress skirt (CLI test)",
+    kind: Garment(
+        garment: "{}/fixtures/patterns/dress/skirt.ron",
+        fabric: "{}",
+        placements: [
+            Trunk(facing_deg: 0.0, y0: 0.98),
+            Trunk(facing_deg: 180.0, y0: 0.98),
+            Trunk(facing_deg: 180.0, y0: 0.98),
+        ],
+        sew_limit: 0.1,
+    ),
+)"#,
+        r.display(),
+        fabric_path()
+    )
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("write scenario");
+    p
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+fn no_panic(err: &str) {
+    assert!(
+        !err.contains("panicked") && !err.contains("backtrace") && !err.contains("RUST_BACKTRACE"),
+        "{err}"
+    );
+}
+
+fn report(dir: &Path) -> atelier::report::Report {
+    let text = std::fs::read_to_string(dir.join("report.json")).expect("report.json");
+    atelier::report::Report::from_json(&text).expect("a complete report")
+}
+
+#[test]
+fn run_writes_the_report_and_outputs_and_succeeds() {
+    let dir = temp_dir("ok");
+    let file = write(&dir, "drape.ron", &drape_scenario(24, 4, 0.2));
+    let out = dir.join("out");
+    let (ok, stdout, err) = atelier(&["run", s(&file), "--out", s(&out), "--frames", "3"]);
+    assert!(ok, "{stdout}{err}");
+    assert!(
+        stdout.starts_with("ok cli_drape: 100 steps") && stdout.lines().count() == 1,
+        "{stdout}"
+    );
+    assert!(err.is_empty(), "quiet when stderr is not a terminal: {err}");
+    let r = report(&out);
+    assert!(r.passed());
+    assert_eq!(r.scenario.file.as_deref(), Some(s(&file)));
+    for name in &r.outputs {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+    assert_eq!(r.outputs.len(), 5, "{:?}", r.outputs);
+    // --frames 3: the animation keeps three of the six frames (t = 0 … 0.2 s every 0.04 s).
+    let glb = std::fs::read(out.join("run.glb")).expect("glb");
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().expect("4 bytes")) as usize;
+    let json = String::from_utf8_lossy(&glb[20..20 + json_len]);
+    assert_eq!(json.matches("frame ").count(), 2, "two morph targets");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn validate_reads_scenarios() {
+    let (ok, out, err) = atelier(&[
+        "validate",
+        "fixtures/scenarios/dress_sewn.ron",
+        "fixtures/scenarios/drape_jis_silk.ron",
+    ]);
+    assert!(ok, "{out}{err}");
+    assert_eq!(out.matches("(scenario)").count(), 2, "{out}");
+}
+
+#[test]
+fn a_bad_scenario_is_reported_with_file_line_column_and_field() {
+    let dir = temp_dir("bad");
+    let file = write(
+        &dir,
+        "bad.ron",
+        "(\n    name: \"bad\", reproduces: \"x\",\n    kind: Drape(fabric: \"f.ron\", tester: Jiss),\n)",
+    );
+    let out = dir.join("out");
+    let (ok, stdout, err) = atelier(&["run", s(&file), "--out", s(&out)]);
+    assert!(!ok);
+    assert!(stdout.is_empty(), "{stdout}");
+    no_panic(&err);
+    assert_eq!(err.lines().count(), 1, "one line: {err}");
+    assert!(
+        err.contains("bad.ron:3:") && err.contains("field `kind.tester`") && err.contains("Jiss"),
+        "{err}"
+    );
+    assert!(
+        !out.exists(),
+        "nothing written for a file that does not read"
+    );
+    // An expectation on a metric the kind does not have: named with its field.
+    let file = write(
+        &dir,
+        "bad_metric.ron",
+        &drape_scenario(24, 4, 0.1).replace("drape_coefficient_percent", "drape_coef"),
+    );
+    let (ok, _, err) = atelier(&["run", s(&file), "--out", s(&out)]);
+    assert!(!ok);
+    assert!(
+        err.contains("bad_metric.ron") && err.contains("expectations[0].metric"),
+        "{err}"
+    );
+    let (ok, stdout, _) = atelier(&["validate", s(&file)]);
+    assert!(!ok && stdout.contains("expectations[0].metric"), "{stdout}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_missing_scenario_or_fabric_fails_with_one_line() {
+    let dir = temp_dir("missing");
+    let out = dir.join("out");
+    let missing = dir.join("nowhere.ron");
+    let (ok, _, err) = atelier(&["run", s(&missing), "--out", s(&out)]);
+    assert!(!ok);
+    no_panic(&err);
+    assert!(
+        err.lines().count() == 1 && err.contains("nowhere.ron") && err.contains("cannot read"),
+        "{err}"
+    );
+    let file = write(
+        &dir,
+        "no_fabric.ron",
+        &drape_scenario(24, 4, 0.1).replace(&fabric_path(), "no_such_fabric.ron"),
+    );
+    let (ok, _, err) = atelier(&["run", s(&file), "--out", s(&out)]);
+    assert!(!ok);
+    no_panic(&err);
+    assert!(
+        err.lines().count() == 1 && err.contains("no_such_fabric.ron"),
+        "{err}"
+    );
+    assert!(!out.join("report.json").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn an_unwritable_output_folder_fails_before_simulating() {
+    // Root can write anywhere; a folder below a regular file cannot be made by anyone.
+    let dir = temp_dir("unwritable");
+    let file = write(&dir, "drape.ron", &drape_scenario(24, 4, 0.1));
+    let blocker = dir.join("a_file");
+    std::fs::write(&blocker, b"not a folder").expect("write");
+    let out = blocker.join("out");
+    let (ok, stdout, err) = atelier(&["run", s(&file), "--out", s(&out)]);
+    assert!(!ok, "{stdout}");
+    no_panic(&err);
+    assert!(
+        err.lines().count() == 1 && err.contains("cannot write") && err.contains("a_file"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_diverging_run_exits_non_zero_with_a_one_line_summary_and_its_report() {
+    let dir = temp_dir("diverge");
+    let text = drape_scenario(24, 4, 0.2).replace(
+        "until_rest: false",
+        "until_rest: false, step: (divergence_strain: 0.0001)",
+    );
+    let file = write(&dir, "diverge.ron", &text);
+    let out = dir.join("out");
+    let (ok, stdout, err) = atelier(&["run", s(&file), "--out", s(&out)]);
+    assert!(!ok);
+    assert!(stdout.is_empty(), "{stdout}");
+    no_panic(&err);
+    assert!(
+        err.lines().count() == 1 && err.contains("FAILED cli_drape") && err.contains("diverging"),
+        "{err}"
+    );
+    let r = report(&out);
+    assert!(r.failure.is_some());
+    assert!(out.join("final.obj").is_file() && out.join("run.glb").is_file());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Killed at any moment — while simulating or while writing — a run leaves every output file
+/// whole: either the previous run's or the new one's (the same bytes here: the scene is
+/// deterministic with one thread), never a part of one; temporary files it may leave beside
+/// them are hidden, and the next run removes them.
+#[test]
+fn an_interrupted_run_leaves_the_previous_outputs_whole() {
+    let dir = temp_dir("interrupt");
+    let file = write(&dir, "drape.ron", &drape_scenario(48, 6, 0.6));
+    let out = dir.join("out");
+    let args = [
+        "run",
+        s(&file),
+        "--out",
+        s(&out),
+        "--threads",
+        "1",
+        "--frames",
+        "1000",
+    ];
+    let clock = std::time::Instant::now();
+    let (ok, stdout, err) = atelier(&args);
+    let full = clock.elapsed();
+    assert!(ok, "{stdout}{err}");
+    let snapshot = |dir: &Path| -> Vec<(String, Vec<u8>)> {
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+            .expect("list")
+            .filter_map(Result::ok)
+            .map(|e| {
+                (
+                    e.file_name().to_string_lossy().into_owned(),
+                    std::fs::read(e.path()).expect("read"),
+                )
+            })
+            .collect();
+        files.sort();
+        files
+    };
+    let before = snapshot(&out);
+    let metrics = report(&out).metrics;
+    for k in 0..10 {
+        // Kills spread over 10 % … 120 % of a full run's time.
+        let delay = full.mul_f64(0.1 + 0.12 * k as f64);
+        let mut child = Command::new(env!("CARGO_BIN_EXE_atelier"))
+            .args(args)
+            .current_dir(root())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("starts");
+        std::thread::sleep(delay);
+        let _ = child.kill();
+        let _ = child.wait();
+        for (name, bytes) in snapshot(&out) {
+            if name.starts_with('.') && name.contains(".tmp-") {
+                continue; // a write cut short, beside the outputs
+            }
+            let old = before
+                .iter()
+                .find(|(n, _)| *n == name)
+                .unwrap_or_else(|| panic!("unexpected file {name}"));
+            if name == "report.json" {
+                let text = String::from_utf8(bytes).expect("utf-8");
+                let r = atelier::report::Report::from_json(&text)
+                    .unwrap_or_else(|e| panic!("kill after {delay:?}: report cut: {e}"));
+                assert_eq!(r.metrics, metrics);
+            } else {
+                assert!(bytes == old.1, "kill after {delay:?}: {name} differs");
+            }
+        }
+        for (name, _) in &before {
+            assert!(out.join(name).is_file(), "{name} lost");
+        }
+    }
+    let (ok, _, err) = atelier(&args);
+    assert!(ok, "{err}");
+    let after = snapshot(&out);
+    assert!(
+        after.iter().all(|(n, _)| !n.contains(".tmp-")),
+        "temporary files left: {:?}",
+        after.iter().map(|(n, _)| n).collect::<Vec<_>>()
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_same_scenario_twice_on_one_thread_gives_identical_metrics() {
+    let dir = temp_dir("determinism");
+    for (name, text) in [
+        ("skirt.ron", skirt_scenario()),
+        ("drape.ron", drape_scenario(24, 4, 0.2)),
+    ] {
+        let file = write(&dir, name, &text);
+        let metrics: Vec<String> = ["a", "b"]
+            .iter()
+            .map(|run| {
+                let out = dir.join(format!("{name}-{run}"));
+                let (_, stdout, err) =
+                    atelier(&["run", s(&file), "--out", s(&out), "--threads", "1"]);
+                no_panic(&err);
+                let text = std::fs::read_to_string(out.join("report.json"))
+                    .unwrap_or_else(|e| panic!("{stdout}{err}: {e}"));
+                // The metrics object exactly as written.
+                let start = text.find("\"metrics\"").expect("metrics");
+                let end = start + text[start..].find('}').expect("end of metrics");
+                text[start..=end].to_string()
+            })
+            .collect();
+        assert!(metrics[0].len() > 100, "{}", metrics[0]);
+        assert_eq!(metrics[0], metrics[1], "{name}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn with_no_arguments_the_default_scenario_runs_from_any_folder() {
+    let dir = temp_dir("default");
+    let out = Command::new(env!("CARGO_BIN_EXE_atelier"))
+        .current_dir(&dir)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    no_panic(&err);
+    // Success, or a run that ended early or missed an expectation (exit 2, still reported):
+    // which one depends on the dressing physics, not on the command.
+    assert!(
+        matches!(out.status.code(), Some(0 | 2)),
+        "{:?}: {err}",
+        out.status
+    );
+    let r = report(&dir.join("atelier-out"));
+    assert_eq!(r.scenario.name, "default");
+    assert!(r.scenario.file.is_none());
+    assert!(dir.join("atelier-out/final.png").is_file());
     std::fs::remove_dir_all(&dir).ok();
 }

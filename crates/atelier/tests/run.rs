@@ -1,0 +1,247 @@
+//! `atelier::run`: a scenario run into a folder — the report's fields present and sane, the
+//! outputs complete, a diverging run still reported with its last good frame, and every fixture
+//! scenario readable. Small, short scenes only (the whole file runs in seconds in release mode).
+
+use std::path::{Path, PathBuf};
+
+use atelier::report::Report;
+use atelier::run::{RunOptions, outputs, run};
+use atelier::scenario::Scenario;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .expect("repository root")
+}
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("atelier-run-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// The skirt placed around the mannequin and sewn for `sew_limit` s (gravity never starts).
+pub fn short_skirt(sew_limit: f64) -> String {
+    let r = root();
+    format!(
+        r#"(
+    name: "short_skirt",
+    reproduces: "the first steps of sewing the dress skirt (test)",
+    kind: Garment(
+        garment: "{}/fixtures/patterns/dress/skirt.ron",
+        fabric: "{}/fixtures/fabrics/cotton_broad.ron",
+        placements: [
+            Trunk(facing_deg: 0.0, y0: 0.98),
+            Trunk(facing_deg: 180.0, y0: 0.98),
+            Trunk(facing_deg: 180.0, y0: 0.98),
+        ],
+        sew_limit: {sew_limit},
+        frame_interval: 0.05,
+    ),
+    expectations: [(metric: "max_penetration_m", max: 0.01), (metric: "pairs_sewn", min: 1000.0)],
+)"#,
+        r.display(),
+        r.display()
+    )
+}
+
+/// A small, short drape (24 × 4 nodes, 0.3 s); `step` is inserted into the scene's `step`
+/// overrides.
+pub fn small_drape(step: &str) -> String {
+    format!(
+        r#"(
+    name: "small_drape",
+    reproduces: "a small, short JIS drape (test)",
+    kind: Drape(fabric: "{}/fixtures/fabrics/cotton_broad.ron", tester: Jis, n_around: 24,
+        n_rings: 4, dt: 0.002, max_time: 0.3, until_rest: false, step: ({step})),
+    expectations: [(metric: "drape_coefficient_percent", min: 0.0, max: 100.0)],
+)"#,
+        root().display()
+    )
+}
+
+fn run_text(text: &str, out: &Path) -> Report {
+    let scenario = Scenario::parse(text, Path::new("test.ron")).expect("scenario");
+    run(
+        &scenario,
+        None,
+        Path::new("."),
+        out,
+        &RunOptions::default(),
+        &mut |_| {},
+    )
+    .expect("runs")
+}
+
+fn finite(v: f64) -> bool {
+    v.is_finite()
+}
+
+#[test]
+fn a_garment_run_reports_every_field_and_writes_complete_outputs() {
+    let out = temp_dir("garment");
+    let report = run_text(&short_skirt(0.2), &out);
+    // What was run.
+    assert_eq!(report.format, Report::FORMAT);
+    assert_eq!(report.scenario.kind, "Garment");
+    assert!(report.fabric.contains("cotton"), "{}", report.fabric);
+    assert!(report.nodes > 100 && report.triangles > 100, "{report:?}");
+    assert_eq!(report.body_triangles, 2832);
+    // Cost.
+    assert_eq!(report.steps, 20, "0.2 s at Δt 0.01 s");
+    assert!((report.dt_s - 0.01).abs() < 1e-15);
+    assert!((report.simulated_s - 0.2).abs() < 1e-9);
+    assert!(report.wall_s > 0.0 && report.setup_s >= 0.0);
+    let st = report.stage_s;
+    let sum = st.bending + st.internal + st.velocity + st.transfer + st.shape + st.collision;
+    assert!(
+        (sum + st.update - st.total).abs() < 1e-6 && st.total <= report.wall_s + 1e-6,
+        "{st:?} / {}",
+        report.wall_s
+    );
+    assert!(st.collision > 0.0, "the body contact was timed");
+    // Metrics: every name the kind declares, finite where measured.
+    let scenario = Scenario::parse(&short_skirt(0.2), Path::new("t.ron")).expect("scenario");
+    for name in scenario.kind.metric_names() {
+        assert!(report.metrics.contains_key(*name), "metric {name} missing");
+    }
+    for (k, v) in &report.metrics {
+        if let Some(v) = v {
+            assert!(finite(*v), "{k} = {v}");
+        }
+    }
+    let m = |k: &str| report.metrics[k].expect(k);
+    assert_eq!(m("nodes") as usize, report.nodes);
+    assert!(m("pairs") > 0.0 && m("pairs_sewn") <= m("pairs"));
+    assert_eq!(
+        m("unsewn_pairs") as usize,
+        (m("pairs") - m("pairs_sewn")) as usize
+    );
+    assert!(report.metrics["sewn_at_s"].is_none(), "not sewn in 0.2 s");
+    assert!((0.0..0.01).contains(&m("max_penetration_m")));
+    assert!(m("kinetic_energy_j") >= 0.0 && m("max_strain_error") >= 0.0);
+    assert_eq!(m("frames") as usize, 5, "t = 0, 0.05, 0.10, 0.15, 0.20");
+    // Expectations: one met, one (deliberately impossible) not.
+    assert_eq!(report.expectations.len(), 2);
+    assert!(report.expectations[0].met);
+    assert!(!report.expectations[1].met);
+    assert!(!report.expectations_met && !report.passed());
+    assert!(report.failure.is_none());
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("sewing not finished")),
+        "{:?}",
+        report.warnings
+    );
+    // Outputs, complete.
+    for name in [
+        outputs::REPORT,
+        outputs::OBJ,
+        outputs::PLY,
+        outputs::GLB,
+        outputs::PICTURE,
+    ] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+    assert!(!report.outputs.iter().any(|o| o == outputs::TOP));
+    let written = std::fs::read_to_string(out.join(outputs::REPORT)).expect("report");
+    assert_eq!(Report::from_json(&written).expect("parses"), report);
+    let glb = std::fs::read(out.join(outputs::GLB)).expect("glb");
+    assert_eq!(&glb[..4], b"glTF");
+    assert_eq!(
+        u32::from_le_bytes(glb[8..12].try_into().expect("4 bytes")) as usize,
+        glb.len()
+    );
+    let png = std::fs::read(out.join(outputs::PICTURE)).expect("png");
+    assert_eq!(&png[1..4], b"PNG");
+    let obj = std::fs::read_to_string(out.join(outputs::OBJ)).expect("obj");
+    let vertices = obj.lines().filter(|l| l.starts_with("v ")).count();
+    assert_eq!(
+        vertices,
+        report.nodes + 1450,
+        "cloth and the 9AR body's 1450 vertices"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .expect("list")
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    std::fs::remove_dir_all(&out).ok();
+}
+
+#[test]
+fn a_diverging_run_still_writes_its_report_and_last_good_frame() {
+    // A divergence limit far below the strains of a falling specimen: the run stops at the
+    // first step that stretches an edge by more than 0.01 %.
+    let out = temp_dir("diverge");
+    let report = run_text(&small_drape("divergence_strain: 0.0001"), &out);
+    let failure = report.failure.as_deref().expect("diverged");
+    assert!(failure.contains("diverging"), "{failure}");
+    assert!(!report.passed());
+    assert!(report.steps < 150, "stopped early: {}", report.steps);
+    // Shape metrics are not measured after a failed step; the expectation on them fails.
+    assert!(report.metrics["drape_coefficient_percent"].is_none());
+    assert!(!report.expectations_met);
+    // Outputs up to the last good frame, and the report.
+    for name in [
+        outputs::REPORT,
+        outputs::OBJ,
+        outputs::PLY,
+        outputs::GLB,
+        outputs::PICTURE,
+        outputs::TOP,
+    ] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+    let obj = std::fs::read_to_string(out.join(outputs::OBJ)).expect("obj");
+    assert!(
+        obj.lines()
+            .filter(|l| l.starts_with("v "))
+            .flat_map(|l| l.split_whitespace().skip(1))
+            .all(|v| v.parse::<f64>().is_ok_and(f64::is_finite)),
+        "finite final frame"
+    );
+    std::fs::remove_dir_all(&out).ok();
+}
+
+#[test]
+fn a_drape_run_measures_its_drape() {
+    let out = temp_dir("drape");
+    let report = run_text(&small_drape(""), &out);
+    assert!(report.passed(), "{}", report.summary_line());
+    let m = |k: &str| report.metrics[k].expect(k);
+    assert_eq!(report.steps, 150);
+    assert!((0.0..=100.0).contains(&m("drape_coefficient_percent")));
+    assert!(m("shadow_area_m2") > 0.0);
+    assert!(m("min_edge_radius_m") <= m("max_edge_radius_m"));
+    assert_eq!(m("nodes") as usize, 96);
+    assert!(report.outputs.iter().any(|o| o == outputs::TOP));
+    std::fs::remove_dir_all(&out).ok();
+}
+
+#[test]
+fn every_fixture_scenario_reads_and_names_existing_files() {
+    let dir = root().join("fixtures/scenarios");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).expect("scenarios") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_none_or(|e| e != "ron") {
+            continue;
+        }
+        let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        s.check_files(&atelier::run::base_of(&path))
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert_eq!(
+            path.file_stem().and_then(|x| x.to_str()),
+            Some(s.name.as_str()),
+            "a scenario's name is its file name"
+        );
+        count += 1;
+    }
+    assert!(count >= 20, "{count} scenarios");
+}

@@ -1,0 +1,396 @@
+//! `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]`: run every scenario of
+//! `fixtures/scenarios/` (or the named ones, or shard I of N), each into `DIR/NAME/`, then write
+//! `DIR/summary.json` and `DIR/summary.md` (scenario, wall time, key metrics, expectations met,
+//! failures). A run of every scenario also regenerates `docs/results.md` (the table and a
+//! gallery of the pictures, copied to `docs/img/results/`). Returns whether every scenario ran
+//! to its end and met its expectations.
+//!
+//! Shards: the scenarios sorted by name, shard I (1-based) of N takes every N-th from the I-th,
+//! so a batch scheduler can spread a sweep over N machines and merge the summaries.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use atelier::report::Report;
+use atelier::run::{RunOptions, base_of, run};
+use atelier::scenario::Scenario;
+use serde::Serialize;
+
+/// One row of the summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    /// Scenario name (the file stem when the file could not be read).
+    pub name: String,
+    /// Scenario file, relative to the repository.
+    pub file: String,
+    /// Kind of scene.
+    pub kind: String,
+    /// Wall time of the whole run (setup, steps, outputs), s.
+    pub wall_s: f64,
+    /// Steps taken.
+    pub steps: usize,
+    /// Simulated time, s.
+    pub simulated_s: f64,
+    /// The key metrics in words.
+    pub key_metrics: String,
+    /// Every expectation met.
+    pub expectations_met: bool,
+    /// Unmet expectations in words.
+    pub unmet: Vec<String>,
+    /// Why the run failed or could not start.
+    pub failure: Option<String>,
+    /// The report, when the run produced one.
+    #[serde(skip)]
+    pub report: Option<Report>,
+}
+
+impl Row {
+    fn passed(&self) -> bool {
+        self.failure.is_none() && self.expectations_met
+    }
+}
+
+/// The whole summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Scenarios run.
+    pub scenarios: usize,
+    /// Scenarios that ran to their end and met their expectations.
+    pub passed: usize,
+    /// Shard run, `I/N`, if any.
+    pub shard: Option<String>,
+    /// Total wall time, s.
+    pub wall_s: f64,
+    /// One row per scenario.
+    pub rows: Vec<Row>,
+}
+
+/// Parse `I/N` (1 ≤ I ≤ N).
+pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
+    let (i, n) = text
+        .split_once('/')
+        .with_context(|| format!("--shard {text}: expected I/N, for example 2/4"))?;
+    let (i, n): (usize, usize) = (
+        i.trim().parse().context("--shard: I is not a number")?,
+        n.trim().parse().context("--shard: N is not a number")?,
+    );
+    if n == 0 || i == 0 || i > n {
+        bail!("--shard {text}: need 1 ≤ I ≤ N");
+    }
+    Ok((i, n))
+}
+
+/// Every scenario file, sorted by name.
+fn scenario_files(root: &Path) -> Result<Vec<PathBuf>> {
+    let dir = root.join("fixtures/scenarios");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .with_context(|| format!("cannot list {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+fn stem(p: &Path) -> String {
+    p.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Run the selection; returns whether all passed.
+pub fn run_all(
+    root: &Path,
+    only: &[String],
+    out: &Path,
+    shard: Option<(usize, usize)>,
+) -> Result<bool> {
+    let all = scenario_files(root)?;
+    for name in only {
+        if !all.iter().any(|f| stem(f) == *name) {
+            bail!(
+                "--only {name}: no fixtures/scenarios/{name}.ron (have: {})",
+                all.iter().map(|f| stem(f)).collect::<Vec<_>>().join(", ")
+            );
+        }
+    }
+    let selected: Vec<&PathBuf> = all
+        .iter()
+        .filter(|f| only.is_empty() || only.contains(&stem(f)))
+        .enumerate()
+        .filter(|(k, _)| shard.is_none_or(|(i, n)| k % n == i - 1))
+        .map(|(_, f)| f)
+        .collect();
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let clock = Instant::now();
+    let mut rows = Vec::new();
+    for (k, file) in selected.iter().enumerate() {
+        eprintln!("[{}/{}] {}", k + 1, selected.len(), stem(file));
+        let row = run_one(root, file, out);
+        eprintln!("    {}", row_line(&row));
+        rows.push(row);
+    }
+    let summary = Summary {
+        scenarios: rows.len(),
+        passed: rows.iter().filter(|r| r.passed()).count(),
+        shard: shard.map(|(i, n)| format!("{i}/{n}")),
+        wall_s: clock.elapsed().as_secs_f64(),
+        rows,
+    };
+    let json = serde_json::to_string_pretty(&summary)? + "\n";
+    atelier_fabric::files::write_atomic(&out.join("summary.json"), json.as_bytes())?;
+    atelier_fabric::files::write_atomic(
+        &out.join("summary.md"),
+        summary_markdown(&summary, None).as_bytes(),
+    )?;
+    eprintln!(
+        "{} of {} scenarios passed; {} and {}",
+        summary.passed,
+        summary.scenarios,
+        out.join("summary.json").display(),
+        out.join("summary.md").display()
+    );
+    if only.is_empty() && shard.is_none() {
+        write_results(root, out, &summary)?;
+        eprintln!("regenerated docs/results.md");
+    } else {
+        eprintln!("docs/results.md left as it was (not every scenario ran)");
+    }
+    Ok(summary.passed == summary.scenarios)
+}
+
+fn run_one(root: &Path, file: &Path, out: &Path) -> Row {
+    let rel = file
+        .strip_prefix(root)
+        .unwrap_or(file)
+        .display()
+        .to_string();
+    let mut row = Row {
+        name: stem(file),
+        file: rel,
+        kind: String::new(),
+        wall_s: 0.0,
+        steps: 0,
+        simulated_s: 0.0,
+        key_metrics: String::new(),
+        expectations_met: false,
+        unmet: Vec::new(),
+        failure: None,
+        report: None,
+    };
+    let scenario = match Scenario::load(file) {
+        Ok(s) => s,
+        Err(e) => {
+            row.failure = Some(e.to_string());
+            return row;
+        }
+    };
+    row.name = scenario.name.clone();
+    row.kind = scenario.kind.name().into();
+    let clock = Instant::now();
+    let result = run(
+        &scenario,
+        Some(file),
+        &base_of(file),
+        &out.join(&scenario.name),
+        &RunOptions::default(),
+        &mut |_| {},
+    );
+    row.wall_s = clock.elapsed().as_secs_f64();
+    match result {
+        Ok(report) => {
+            row.steps = report.steps;
+            row.simulated_s = report.simulated_s;
+            row.key_metrics = key_metrics(&report);
+            row.expectations_met = report.expectations_met;
+            row.unmet = report
+                .expectations
+                .iter()
+                .filter(|e| !e.met)
+                .map(|e| {
+                    format!(
+                        "{} = {} (want {})",
+                        e.metric,
+                        e.value.map_or("not measured".into(), number),
+                        bound(e.min, e.max)
+                    )
+                })
+                .collect();
+            row.failure = report.failure.clone();
+            row.report = Some(report);
+        }
+        Err(e) => row.failure = Some(e.to_string()),
+    }
+    row
+}
+
+/// A value in words: integers without decimals, others to four significant digits.
+fn number(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.4e}")
+            .parse::<f64>()
+            .map_or(format!("{v}"), |r| format!("{r}"))
+    }
+}
+
+fn bound(min: Option<f64>, max: Option<f64>) -> String {
+    match (min, max) {
+        (Some(a), Some(b)) => format!("{a} … {b}"),
+        (Some(a), None) => format!("≥ {a}"),
+        (None, Some(b)) => format!("≤ {b}"),
+        (None, None) => "any".into(),
+    }
+}
+
+/// The metrics that say most about each kind of scene, in words.
+fn key_metrics(r: &Report) -> String {
+    let m = |k: &str| r.metrics.get(k).copied().flatten();
+    let f = |v: Option<f64>, digits: usize, unit: &str| {
+        v.map_or("–".to_string(), |v| format!("{v:.digits$}{unit}"))
+    };
+    match r.scenario.kind.as_str() {
+        "Garment" => format!(
+            "sewn {}/{} pairs{}, deepest inside body {}, max strain error {}",
+            f(m("pairs_sewn"), 0, ""),
+            f(m("pairs"), 0, ""),
+            m("sewn_at_s").map_or(String::new(), |t| format!(" at {t:.2} s")),
+            f(m("max_penetration_m").map(|v| v * 1e3), 1, " mm"),
+            f(m("max_strain_error"), 3, ""),
+        ),
+        "Drape" => format!(
+            "DC {}, {} nodes, {}",
+            f(m("drape_coefficient_percent"), 1, " %"),
+            f(m("node_count"), 0, ""),
+            if m("settled") == Some(1.0) {
+                "at rest"
+            } else {
+                "not at rest"
+            }
+        ),
+        "Cantilever" => format!(
+            "chord angle {} (elastica 41.5°), c = {}",
+            f(m("chord_angle_deg"), 2, "°"),
+            f(m("bending_length_m").map(|v| v * 100.0), 2, " cm")
+        ),
+        "Catenary" => format!(
+            "max deviation {} of the span",
+            f(m("max_deviation_percent_span"), 3, " %")
+        ),
+        _ => String::new(),
+    }
+}
+
+fn row_line(r: &Row) -> String {
+    let outcome = if let Some(f) = &r.failure {
+        format!("FAILED: {f}")
+    } else if !r.expectations_met {
+        format!("EXPECTATION NOT MET: {}", r.unmet.join("; "))
+    } else {
+        "ok".into()
+    };
+    format!(
+        "{:.1} s wall, {} steps, {:.2} s simulated; {}; {outcome}",
+        r.wall_s, r.steps, r.simulated_s, r.key_metrics
+    )
+}
+
+/// The summary as a markdown table; `pictures` (a folder relative to the document) adds a
+/// gallery.
+fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "{} of {} scenarios ran to their end and met their expectations{}; {:.0} s wall in all.\n",
+        s.passed,
+        s.scenarios,
+        s.shard
+            .as_ref()
+            .map_or(String::new(), |x| format!(" (shard {x})")),
+        s.wall_s
+    );
+    let _ = writeln!(
+        md,
+        "| scenario | kind | wall s | steps | simulated s | key metrics | expectations | failure |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    for r in &s.rows {
+        let expectations = if r.unmet.is_empty() {
+            if r.report.as_ref().is_some_and(|x| x.expectations.is_empty()) {
+                "none".to_string()
+            } else if r.report.is_some() {
+                "met".to_string()
+            } else {
+                "–".to_string()
+            }
+        } else {
+            format!("**not met**: {}", r.unmet.join("; "))
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.1} | {} | {:.2} | {} | {} | {} |",
+            r.name,
+            r.kind,
+            r.wall_s,
+            r.steps,
+            r.simulated_s,
+            r.key_metrics,
+            expectations,
+            r.failure
+                .as_deref()
+                .map_or("–".to_string(), |f| f.replace('|', "\\|"))
+        );
+    }
+    if let Some(dir) = pictures {
+        let _ = writeln!(md, "\n## Gallery\n");
+        for r in &s.rows {
+            if r.report
+                .as_ref()
+                .is_some_and(|x| x.outputs.iter().any(|o| o == "final.png"))
+            {
+                let reproduces = r
+                    .report
+                    .as_ref()
+                    .map(|x| x.scenario.reproduces.clone())
+                    .unwrap_or_default();
+                let _ = writeln!(
+                    md,
+                    "### {}\n\n{}\n\n![{}]({dir}/{}.png)\n",
+                    r.name, reproduces, r.name, r.name
+                );
+            }
+        }
+    }
+    md
+}
+
+/// Regenerate `docs/results.md` and copy each scenario's picture to `docs/img/results/`.
+fn write_results(root: &Path, out: &Path, s: &Summary) -> Result<()> {
+    let img = root.join("docs/img/results");
+    std::fs::create_dir_all(&img)?;
+    for r in &s.rows {
+        let from = out.join(&r.name).join("final.png");
+        if r.report
+            .as_ref()
+            .is_some_and(|x| x.outputs.iter().any(|o| o == "final.png"))
+        {
+            let bytes =
+                std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
+            atelier_fabric::files::write_atomic(&img.join(format!("{}.png", r.name)), &bytes)?;
+        }
+    }
+    let mut md = String::from(
+        "# Results: every scenario\n\n\
+         Generated by `cargo xtask run-scenarios` (do not edit by hand): every scenario of\n\
+         `fixtures/scenarios/` run once on the 2-core machine, in release mode, one after the\n\
+         other. Each row is the scenario's `report.json` (schema: [report.md](report.md)) in short;\n\
+         a failed run still wrote its report and its outputs up to the last good frame, and its\n\
+         picture below shows that frame. Wall times include loading, gridding and writing.\n\n",
+    );
+    md.push_str(&summary_markdown(s, Some("img/results")));
+    atelier_fabric::files::write_atomic(&root.join("docs/results.md"), md.as_bytes())?;
+    Ok(())
+}
