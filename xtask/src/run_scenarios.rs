@@ -356,9 +356,18 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
                     .as_ref()
                     .map(|x| x.scenario.reproduces.clone())
                     .unwrap_or_default();
+                let top = if r
+                    .report
+                    .as_ref()
+                    .is_some_and(|x| x.outputs.iter().any(|o| o == "top.png"))
+                {
+                    format!(" ![{} from above]({dir}/{}-top.png)", r.name, r.name)
+                } else {
+                    String::new()
+                };
                 let _ = writeln!(
                     md,
-                    "### {}\n\n{}\n\n![{}]({dir}/{}.png)\n",
+                    "### {}\n\n{}\n\n![{}]({dir}/{}.png){top}\n",
                     r.name, reproduces, r.name, r.name
                 );
             }
@@ -380,6 +389,15 @@ fn write_results(root: &Path, out: &Path, s: &Summary) -> Result<()> {
             let bytes =
                 std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
             atelier_fabric::files::write_atomic(&img.join(format!("{}.png", r.name)), &bytes)?;
+        }
+        if r.report
+            .as_ref()
+            .is_some_and(|x| x.outputs.iter().any(|o| o == "top.png"))
+        {
+            let from = out.join(&r.name).join("top.png");
+            let bytes =
+                std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
+            atelier_fabric::files::write_atomic(&img.join(format!("{}-top.png", r.name)), &bytes)?;
         }
     }
     let mut md = String::from(
