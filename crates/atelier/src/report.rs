@@ -165,7 +165,7 @@ impl Report {
         s
     }
 
-    /// Read a report back.
+    /// Read a report back (numbers exactly as written: serde_json's `float_roundtrip`).
     pub fn from_json(text: &str) -> Result<Self, serde_json::Error> {
         serde_json::from_str(text)
     }
