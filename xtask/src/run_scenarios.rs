@@ -376,6 +376,32 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
     md
 }
 
+/// The repository's commit, marked when tracked files had uncommitted changes (the results
+/// then come from code no commit holds).
+fn commit(root: &Path) -> String {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .current_dir(root)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    match git(&["rev-parse", "--short", "HEAD"]) {
+        Some(hash) => {
+            let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
+                .is_some_and(|s| !s.is_empty());
+            if dirty {
+                format!("`{hash}` with uncommitted changes")
+            } else {
+                format!("`{hash}`")
+            }
+        }
+        None => "unknown (not a git checkout)".into(),
+    }
+}
+
 /// Regenerate `docs/results.md` and copy each scenario's picture to `docs/img/results/`.
 fn write_results(root: &Path, out: &Path, s: &Summary) -> Result<()> {
     let img = root.join("docs/img/results");
@@ -408,6 +434,7 @@ fn write_results(root: &Path, out: &Path, s: &Summary) -> Result<()> {
          a failed run still wrote its report and its outputs up to the last good frame, and its\n\
          picture below shows that frame. Wall times include loading, gridding and writing.\n\n",
     );
+    let _ = writeln!(md, "Run at commit {}.\n", commit(root));
     md.push_str(&summary_markdown(s, Some("img/results")));
     atelier_fabric::files::write_atomic(&root.join("docs/results.md"), md.as_bytes())?;
     Ok(())
