@@ -2,9 +2,12 @@
 //! body motion (staged model) and the physical collision pass (cloth against the body, cloth
 //! against itself), over plain slices.
 
+use rayon::prelude::*;
+
 use crate::broad::{BroadKind, BroadPhase, new_broad};
 use crate::geom::V3;
 use crate::narrow::{Hit, NarrowTest, Sides, point_triangle, point_triangle_thesis};
+use crate::parts::{Motion, PartsError, RigidParts};
 use crate::response::{ContactMaterial, respond};
 
 /// How collisions are computed.
@@ -35,6 +38,26 @@ pub struct ContactParams {
     /// a node squeezed into a crease between two moving parts otherwise stays inside). 0 turns
     /// it off; keep it below half the thinnest body part.
     pub recovery_depth: f64,
+    /// Body contact kept inside the shape iterations (addition; see `docs/collision.md`): a
+    /// node within this distance of the body at the start of the step, or that met it in a
+    /// pass, gets the body's tangent plane (moved to the end of the step) as a one-sided
+    /// constraint that every shape iteration respects, so the cloth's constraints and the
+    /// contact are solved together instead of in turn. 0 turns it off. Default 0.01 m.
+    pub plane_reach: f64,
+}
+
+/// A one-sided contact constraint for one node: its position at the end of the step must
+/// satisfy `(x − point)·normal ≥ 0`. A zero normal means none.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactPlane {
+    /// A point of the plane (the body surface plus the skin), end of step, m.
+    pub point: V3,
+    /// Unit normal, away from the body; zero when the node has no plane.
+    pub normal: V3,
+    /// The body point's velocity over the step (friction acts on the velocity relative to it).
+    pub velocity: V3,
+    /// Static friction ρ of the contact.
+    pub friction: f64,
 }
 
 impl Default for ContactParams {
@@ -52,6 +75,7 @@ impl Default for ContactParams {
             broad: BroadKind::Bvh,
             narrow: NarrowTest::Exact,
             recovery_depth: 5e-3,
+            plane_reach: 0.01,
         }
     }
 }
@@ -93,12 +117,15 @@ pub enum ContactError {
         /// Vertex.
         vertex: usize,
     },
+    /// The rigid parts or their motion were refused.
+    #[error(transparent)]
+    Parts(#[from] PartsError),
 }
 
 impl ContactParams {
     /// Check the ranges.
     pub fn check(&self) -> Result<(), ContactError> {
-        let rules: [(&'static str, f64, bool, &'static str); 4] = [
+        let rules: [(&'static str, f64, bool, &'static str); 5] = [
             (
                 "restitution",
                 self.material.restitution,
@@ -121,6 +148,12 @@ impl ContactParams {
                 "transfer_margin",
                 self.transfer_margin,
                 self.transfer_margin >= 0.0 && self.transfer_margin.is_finite(),
+                "≥ 0 m, finite",
+            ),
+            (
+                "plane_reach",
+                self.plane_reach,
+                self.plane_reach >= 0.0 && self.plane_reach.is_finite(),
                 "≥ 0 m, finite",
             ),
         ];
@@ -148,6 +181,9 @@ pub struct ClothView<'a> {
     pub triangles: &'a [[u32; 3]],
     /// Unit node normals (for one-sided contact); may be empty when not needed.
     pub normals: &'a [V3],
+    /// Contact planes the shape iterations respect (`ContactParams::plane_reach`), one per
+    /// node; may be empty when not used.
+    pub planes: &'a mut [ContactPlane],
 }
 
 /// Counts of one pass.
@@ -163,6 +199,9 @@ pub struct PassStats {
     pub transferred: usize,
     /// Nodes found inside the body (shallower than the recovery depth) and moved out.
     pub recovered: usize,
+    /// Nodes given a contact plane for the shape iterations (within `plane_reach` of the body,
+    /// or inside it, at the start of the step).
+    pub planes: usize,
 }
 
 struct Body {
@@ -181,6 +220,11 @@ struct Body {
 pub struct Collider {
     params: ContactParams,
     body: Option<Body>,
+    /// The body as rigid parts (exact union distance) for the nearest-point queries: transfer
+    /// and contact planes. Without it they use the body's triangles.
+    parts: Option<RigidParts>,
+    /// Per node: velocity change and contact plane found by the parts transfer.
+    part_results: Vec<Option<(V3, Option<ContactPlane>)>>,
     cloth_broad: Option<Box<dyn BroadPhase>>,
     candidates: Vec<u32>,
     cloth_end: Vec<V3>,
@@ -194,6 +238,8 @@ impl Collider {
         Ok(Self {
             params,
             body: None,
+            parts: None,
+            part_results: Vec::new(),
             cloth_broad: None,
             candidates: Vec::new(),
             cloth_end: Vec::new(),
@@ -284,11 +330,40 @@ impl Collider {
     /// Remove the body (nothing collides with it afterwards).
     pub fn clear_body(&mut self) {
         self.body = None;
+        self.parts = None;
+    }
+
+    /// The body as rigid parts as well (its triangles, given to [`Collider::set_body`], keep the
+    /// continuous test): the transfer of body motion and the contact planes then take the
+    /// nearest point of the parts' union, which no face buried in another part can be.
+    pub fn set_parts(&mut self, parts: RigidParts) {
+        self.parts = Some(parts);
+    }
+
+    /// The rigid parts, if set.
+    pub fn parts(&self) -> Option<&RigidParts> {
+        self.parts.as_ref()
+    }
+
+    /// The parts' motion over the coming step (rest → world at its start and end).
+    ///
+    /// # Errors
+    /// [`ContactError::Parts`] when no parts are set or the motion is refused.
+    pub fn set_part_motion(
+        &mut self,
+        start: &[Motion],
+        end: &[Motion],
+        dt: f64,
+    ) -> Result<(), ContactError> {
+        match self.parts.as_mut() {
+            Some(parts) => Ok(parts.set_motion(start, end, dt)?),
+            None => Err(ContactError::Parts(PartsError::Empty)),
+        }
     }
 
     /// Whether any collision work is configured.
     pub fn is_active(&self) -> bool {
-        self.body.is_some() || self.params.self_collision
+        self.body.is_some() || self.parts.is_some() || self.params.self_collision
     }
 
     /// The staged model's geometric stage (thesis §5.4, (75)): every free cloth node within
@@ -296,13 +371,43 @@ impl Collider {
     /// outside, takes on the change of the body's velocity at the nearest body point since the
     /// previous step, so the cloth moves with the body and the physical stage sees a small
     /// relative speed.
-    pub fn transfer(&mut self, positions: &[V3], velocities: &mut [V3], inverse_masses: &[f64]) {
-        if !self.params.staged {
+    pub fn transfer(
+        &mut self,
+        positions: &[V3],
+        velocities: &mut [V3],
+        inverse_masses: &[f64],
+        planes: &mut [ContactPlane],
+    ) {
+        if self.parts.is_some() {
+            self.transfer_parts(positions, velocities, inverse_masses, planes);
             return;
         }
         let Some(body) = self.body.as_ref() else {
             return;
         };
+        if !self.params.staged {
+            if self.params.plane_reach > 0.0 && !planes.is_empty() {
+                for (i, p) in positions.iter().enumerate() {
+                    if inverse_masses[i] == 0.0 {
+                        continue;
+                    }
+                    self.candidates.clear();
+                    body.broad
+                        .query(p, p, self.params.plane_reach, &mut self.candidates);
+                    if let Some((dist, t, w)) = nearest_outside(
+                        body,
+                        p,
+                        &self.candidates,
+                        self.params.plane_reach,
+                        self.params.thickness,
+                    ) {
+                        planes[i] = tangent_plane(body, p, dist, t, w, &self.params);
+                        self.stats.planes += 1;
+                    }
+                }
+            }
+            return;
+        }
         let reach = body.max_displacement + self.params.transfer_margin;
         // Search a small ball first: most cloth near a body is within a centimetre of it, and a
         // nearest point found inside the small ball is the nearest within the whole reach (any
@@ -322,7 +427,11 @@ impl Collider {
                     break;
                 }
             }
-            if let Some((_, t, w)) = best {
+            if let Some((dist, t, w)) = best {
+                if dist < self.params.plane_reach && !planes.is_empty() {
+                    planes[i] = tangent_plane(body, p, dist, t, w, &self.params);
+                    self.stats.planes += 1;
+                }
                 let tri = body.triangles[t];
                 let dv: V3 = (0..3)
                     .map(|k| (body.vel[tri[k] as usize] - body.prev_vel[tri[k] as usize]) * w[k])
@@ -332,6 +441,74 @@ impl Collider {
             }
         }
         self.stats.transferred += transferred;
+    }
+
+    /// The transfer on rigid parts, node by node in parallel: the nearest point of the union
+    /// within reach (the parts' largest displacement plus the margin when staged, else the
+    /// plane reach) gives the change of the body's velocity (staged, nodes outside) and, within
+    /// `plane_reach` or inside, the contact plane at the end of the step.
+    fn transfer_parts(
+        &mut self,
+        positions: &[V3],
+        velocities: &mut [V3],
+        inverse_masses: &[f64],
+        planes: &mut [ContactPlane],
+    ) {
+        let Some(parts) = self.parts.as_ref() else {
+            return;
+        };
+        let p = self.params;
+        let with_planes = p.plane_reach > 0.0 && !planes.is_empty();
+        let reach = if p.staged {
+            (parts.max_displacement() + p.transfer_margin).max(p.plane_reach)
+        } else if with_planes {
+            p.plane_reach
+        } else {
+            return;
+        };
+        self.part_results.clear();
+        self.part_results.resize(positions.len(), None);
+        let find = |(i, out): (usize, &mut Option<(V3, Option<ContactPlane>)>)| {
+            if inverse_masses[i] == 0.0 {
+                return;
+            }
+            let Some(n) = parts.nearest(&positions[i], reach, false) else {
+                return;
+            };
+            let dv = if p.staged && n.distance >= -p.thickness {
+                parts.velocity_change(&n)
+            } else {
+                V3::zeros()
+            };
+            let plane = (with_planes && n.distance < p.plane_reach).then(|| {
+                let (q, normal) = parts.place(&n, true);
+                ContactPlane {
+                    point: q + normal * p.thickness,
+                    normal,
+                    velocity: parts.velocity(&n),
+                    friction: p.material.friction,
+                }
+            });
+            *out = Some((dv, plane));
+        };
+        if positions.len() >= 256 {
+            self.part_results.par_iter_mut().enumerate().for_each(find);
+        } else {
+            self.part_results.iter_mut().enumerate().for_each(find);
+        }
+        for (i, r) in self.part_results.iter().enumerate() {
+            let Some((dv, plane)) = r else {
+                continue;
+            };
+            if p.staged {
+                velocities[i] += dv;
+                self.stats.transferred += 1;
+            }
+            if let Some(plane) = plane {
+                planes[i] = *plane;
+                self.stats.planes += 1;
+            }
+        }
     }
 
     /// One physical collision pass: every free node against the body's triangles (moving from
@@ -348,6 +525,7 @@ impl Collider {
             inverse_masses,
             triangles,
             normals,
+            planes,
         } = cloth;
         let n = positions.len();
         let p = self.params;
@@ -422,6 +600,7 @@ impl Collider {
                 let Some((hit, t, is_cloth)) = best else {
                     if round == 0
                         && p.recovery_depth > p.thickness
+                        && self.parts.is_none()
                         && let Some(body) = self.body.as_ref()
                         && let Some(dv) = recover(body, &pi, &vi, dt, p, &mut self.candidates)
                     {
@@ -458,6 +637,20 @@ impl Collider {
                 };
                 velocities[i] = r.mean;
                 exit[i] += r.exit - r.mean;
+                if !is_cloth && p.plane_reach > 0.0 && !planes.is_empty() {
+                    let body = self.body.as_ref().expect("body hit");
+                    let q: V3 = (0..3)
+                        .map(|k| body.end[tri[k] as usize] * hit.weights[k])
+                        .sum();
+                    planes[i] = ContactPlane {
+                        point: q + hit.normal * p.thickness,
+                        normal: hit.normal,
+                        velocity: (0..3)
+                            .map(|k| body.vel[tri[k] as usize] * hit.weights[k])
+                            .sum(),
+                        friction: p.material.friction,
+                    };
+                }
                 if is_cloth {
                     for k in 0..3 {
                         velocities[tri[k] as usize] += r.vertex_dv[k];
@@ -468,6 +661,34 @@ impl Collider {
                 }
             }
         }
+    }
+}
+
+/// The tangent plane of the body at the point with weights `w` of triangle `t` nearest to `p`
+/// (at `dist`), carried to the end of the step and lifted by the skin: the normal points from
+/// the nearest point to the node (the triangle's normal when the node is on the surface).
+fn tangent_plane(
+    body: &Body,
+    p: &V3,
+    dist: f64,
+    t: usize,
+    w: [f64; 3],
+    params: &ContactParams,
+) -> ContactPlane {
+    let tri = body.triangles[t];
+    let q0: V3 = (0..3).map(|k| body.start[tri[k] as usize] * w[k]).sum();
+    let q1: V3 = (0..3).map(|k| body.end[tri[k] as usize] * w[k]).sum();
+    let normal = if dist > 1e-9 {
+        (p - q0) / (p - q0).norm()
+    } else {
+        let x = tri.map(|k| body.start[k as usize]);
+        (x[1] - x[0]).cross(&(x[2] - x[0])).normalize()
+    };
+    ContactPlane {
+        point: q1 + normal * params.thickness,
+        normal,
+        velocity: (0..3).map(|k| body.vel[tri[k] as usize] * w[k]).sum(),
+        friction: params.material.friction,
     }
 }
 

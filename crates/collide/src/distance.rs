@@ -134,6 +134,18 @@ fn check_vertices(vertices: &[V3]) -> Result<(), MeshError> {
     }
 }
 
+/// A non-empty mesh with finite vertices, closed and consistently oriented.
+pub(crate) fn check_closed(vertices: &[V3], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
+    if vertices.is_empty() || triangles.is_empty() {
+        return Err(MeshError::Empty {
+            vertices: vertices.len(),
+            triangles: triangles.len(),
+        });
+    }
+    check_vertices(vertices)?;
+    check_topology(vertices.len(), triangles)
+}
+
 /// Every edge shared by exactly two triangles, running opposite ways.
 fn check_topology(n_vertices: usize, triangles: &[[u32; 3]]) -> Result<(), MeshError> {
     // Undirected edge → (use count, first triangle); directed edge → first triangle.
@@ -196,14 +208,7 @@ impl BodyDistance {
     /// # Errors
     /// A [`MeshError`] naming the offending triangle, edge or vertex.
     pub fn new(vertices: &[V3], triangles: &[[u32; 3]]) -> Result<Self, MeshError> {
-        if vertices.is_empty() || triangles.is_empty() {
-            return Err(MeshError::Empty {
-                vertices: vertices.len(),
-                triangles: triangles.len(),
-            });
-        }
-        check_vertices(vertices)?;
-        check_topology(vertices.len(), triangles)?;
+        check_closed(vertices, triangles)?;
         let verts: Vec<PVec> = vertices.iter().map(to_glam).collect();
         let mesh = TriMesh::with_flags(
             verts,
@@ -276,23 +281,7 @@ mod tests {
 
     /// Unit cube [0, 1]³, 12 triangles, outward normals.
     fn cube() -> (Vec<V3>, Vec<[u32; 3]>) {
-        let v: Vec<V3> = (0..8)
-            .map(|i| V3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-            .collect();
-        let quads = [
-            [0, 2, 3, 1], // z = 0, normal −z
-            [4, 5, 7, 6], // z = 1
-            [0, 1, 5, 4], // y = 0
-            [2, 6, 7, 3], // y = 1
-            [0, 4, 6, 2], // x = 0
-            [1, 3, 7, 5], // x = 1
-        ];
-        let mut t = Vec::new();
-        for [a, b, c, d] in quads {
-            t.push([a, b, c]);
-            t.push([a, c, d]);
-        }
-        (v, t)
+        crate::shapes::box_mesh(V3::zeros(), V3::repeat(1.0))
     }
 
     /// Exact signed distance to the unit cube.

@@ -8,9 +8,11 @@ pub mod collider;
 pub mod distance;
 pub mod geom;
 pub mod narrow;
+pub mod parts;
 pub mod response;
 pub mod shapes;
 
-pub use collider::{ClothView, Collider, ContactError, ContactParams, PassStats};
+pub use collider::{ClothView, Collider, ContactError, ContactParams, ContactPlane, PassStats};
 pub use geom::{Aabb, V3};
+pub use parts::{Nearest, RigidParts};
 pub use response::ContactMaterial;

@@ -34,3 +34,30 @@ pub fn cylinder(radius: f64, length: f64, around: usize, rings: usize) -> (Vec<V
     }
     (v, t)
 }
+
+/// The box between corners `lo` and `hi`: 8 vertices, 12 outward triangles.
+pub fn box_mesh(lo: V3, hi: V3) -> (Vec<V3>, Vec<[u32; 3]>) {
+    let v: Vec<V3> = (0..8)
+        .map(|i| {
+            V3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if (i >> 1) & 1 == 0 { lo.y } else { hi.y },
+                if (i >> 2) & 1 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    let quads = [
+        [0, 2, 3, 1], // z = lo, normal −z
+        [4, 5, 7, 6], // z = hi
+        [0, 1, 5, 4], // y = lo
+        [2, 6, 7, 3], // y = hi
+        [0, 4, 6, 2], // x = lo
+        [1, 3, 7, 5], // x = hi
+    ];
+    let mut t = Vec::new();
+    for [a, b, c, d] in quads {
+        t.push([a, b, c]);
+        t.push([a, c, d]);
+    }
+    (v, t)
+}

@@ -27,6 +27,7 @@ fn step(c: &mut Collider, part: &mut Particle, dt: f64) {
             inverse_masses: &[1.0],
             triangles: &[],
             normals: &[part.normal],
+            planes: &mut [],
         },
         dt,
     );
@@ -175,6 +176,7 @@ proptest! {
             inverse_masses: &[1.0],
             triangles: &[],
             normals: &[],
+            planes: &mut [],
         }, dt);
         let q = p + vels[0] * dt;
         // Relative to the triangle (it translates): the path p → q against the static triangle
@@ -251,6 +253,7 @@ fn without_a_body_or_self_collision_nothing_is_built_or_done() {
             inverse_masses: &[1.0],
             triangles: &[],
             normals: &[],
+            planes: &mut [],
         },
         0.01,
     );
@@ -292,6 +295,7 @@ fn self_collision_stops_a_node_at_a_cloth_triangle_and_conserves_momentum() {
             inverse_masses: &inv,
             triangles: &[[0, 1, 2]],
             normals: &[],
+            planes: &mut [],
         },
         dt,
     );
@@ -327,6 +331,7 @@ fn a_node_slightly_inside_the_body_is_moved_out_within_the_step() {
                 inverse_masses: &[1.0],
                 triangles: &[],
                 normals: &[],
+                planes: &mut [],
             },
             dt,
         );

@@ -221,7 +221,15 @@ impl Cloth {
                 .filter(|&&c| c != NO_NODE)
                 .map(|&c| topology.cells()[c as usize].area)
                 .sum();
-            *w = 0.5 * area / e.rest_length;
+            *w = if area > 0.0 {
+                0.5 * area / e.rest_length
+            } else {
+                // An edge no cell touches (a bridge the gridding left between two dart apexes):
+                // it carries the mean of its nodes' areas across its length, which equals the
+                // cell-based width on a regular grid.
+                0.5 * (topology.node_areas()[e.a as usize] + topology.node_areas()[e.b as usize])
+                    / e.rest_length
+            };
         }
         let colouring = topology.edge_colours();
         let colours = colouring.len();

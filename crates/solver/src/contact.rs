@@ -1,7 +1,10 @@
 //! The collision hook the step calls: [`atelier_collide::Collider`] adapted to a [`Cloth`] — its
 //! triangles for self-collision, its node normals for one-sided contact, its inverse masses.
 
-use atelier_collide::{ClothView, Collider, ContactError, ContactParams, PassStats, V3};
+use atelier_collide::parts::Motion;
+use atelier_collide::{
+    ClothView, Collider, ContactError, ContactParams, PassStats, RigidParts, V3,
+};
 
 use crate::cloth::Cloth;
 use crate::step::{CollisionHook, HookContext};
@@ -35,6 +38,29 @@ impl BodyContact {
         self.collider.set_body(start, end, triangles, dt)
     }
 
+    /// The body as rigid parts too (see [`Collider::set_parts`]).
+    pub fn set_parts(&mut self, parts: RigidParts) {
+        self.collider.set_parts(parts);
+    }
+
+    /// The rigid parts, if set.
+    pub fn parts(&self) -> Option<&RigidParts> {
+        self.collider.parts()
+    }
+
+    /// The parts' motion over the coming step.
+    ///
+    /// # Errors
+    /// When no parts are set or the motion is refused.
+    pub fn set_part_motion(
+        &mut self,
+        start: &[Motion],
+        end: &[Motion],
+        dt: f64,
+    ) -> Result<(), ContactError> {
+        self.collider.set_part_motion(start, end, dt)
+    }
+
     /// Counts since the last call.
     pub fn take_stats(&mut self) -> PassStats {
         self.collider.take_stats()
@@ -62,8 +88,12 @@ impl BodyContact {
 
 impl CollisionHook for BodyContact {
     fn transfer(&mut self, ctx: HookContext<'_>) {
-        self.collider
-            .transfer(ctx.positions, ctx.velocities, ctx.inverse_masses);
+        self.collider.transfer(
+            ctx.positions,
+            ctx.velocities,
+            ctx.inverse_masses,
+            ctx.planes,
+        );
     }
 
     fn resolve(&mut self, ctx: HookContext<'_>) {
@@ -83,6 +113,7 @@ impl CollisionHook for BodyContact {
                 inverse_masses: ctx.inverse_masses,
                 triangles: &self.triangles,
                 normals: &self.normals,
+                planes: ctx.planes,
             },
             ctx.dt,
         );

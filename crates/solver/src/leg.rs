@@ -89,7 +89,8 @@ pub struct LegRun {
     pub wall: Duration,
     /// Wall time of the collision hook (transfer and passes).
     pub collision: Duration,
-    /// Node–leg contacts resolved, over all passes and steps.
+    /// Node–leg contacts, over all passes and steps: continuous-test hits plus nodes held by a
+    /// contact plane (within `plane_reach` of the leg at the start of a step).
     pub contacts: usize,
     /// Node transfers of the leg's motion, over all steps.
     pub transfers: usize,
@@ -165,7 +166,7 @@ pub fn run_leg(scene: &LegScene, fabric: &Fabric) -> Result<LegRun, LegError> {
         run.wall += t0.elapsed();
         run.collision += report.timings.collision + report.timings.transfer;
         let stats = contact.take_stats();
-        run.contacts += stats.body_hits;
+        run.contacts += stats.body_hits + stats.planes;
         run.transfers += stats.transferred;
         distance.update(&end)?;
         let pen = distance.penetrations(&state.positions, scene.tolerance);

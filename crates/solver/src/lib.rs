@@ -30,4 +30,5 @@ pub use shear::ShearCurve;
 pub use state::ClothState;
 pub use step::{
     CollisionHook, HookContext, NoCollision, Solver, Stage, StageTimings, StepError, StepReport,
+    Tie,
 };

@@ -174,6 +174,25 @@ pub struct HookContext<'a> {
     pub time: f64,
     /// Which pass (0-based).
     pub pass: usize,
+    /// Contact planes (one per node, a zero normal for none) that the following shape
+    /// iterations respect; a hook sets them for nodes touching the body. Reset every step.
+    pub planes: &'a mut [atelier_collide::ContactPlane],
+    /// Node pairs held within a distance inside the shape iterations (seams being sewn, sewn
+    /// seams); a hook adds them in `transfer`. Cleared every step.
+    pub ties: &'a mut Vec<Tie>,
+}
+
+/// Two nodes that must end the step no farther apart than `length` (a seam being drawn
+/// together, or sewn at length 0). Each shape iteration moves a pair that is too far apart
+/// towards its mass-weighted centre (momentum kept) until it is `length` apart.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tie {
+    /// First node.
+    pub a: u32,
+    /// Second node.
+    pub b: u32,
+    /// Largest distance at the end of the step, m.
+    pub length: f64,
 }
 
 /// The collision stages of a step: a transfer after the unconstrained velocity (the staged
@@ -230,6 +249,12 @@ struct Scratch {
     shear: Vec<f64>,
     /// Accumulated XPBD multipliers of compliant diagonals (reset each step).
     lambda_c: Vec<f64>,
+    /// Contact planes set by the hooks this step.
+    planes: Vec<atelier_collide::ContactPlane>,
+    /// Nodes with a contact plane.
+    plane_nodes: Vec<u32>,
+    /// Node pairs held within a distance this step.
+    ties: Vec<Tie>,
     vel: Vec<V3>,
     vel_prev: Vec<V3>,
     vel_hat: Vec<V3>,
@@ -481,6 +506,11 @@ impl Solver {
         // 3b. Transfer of body motion (staged collision model).
         let t0 = Instant::now();
         self.s.exit.iter_mut().for_each(|e| *e = V3::zeros());
+        self.s
+            .planes
+            .iter_mut()
+            .for_each(|p| *p = atelier_collide::ContactPlane::default());
+        self.s.ties.clear();
         hook.transfer(HookContext {
             positions: &state.positions,
             velocities: &mut self.s.vel,
@@ -489,6 +519,8 @@ impl Solver {
             dt,
             time: state.time,
             pass: 0,
+            planes: &mut self.s.planes,
+            ties: &mut self.s.ties,
         });
         if let Some(i) = first_non_finite_v(&self.s.vel) {
             return Err(non_finite(Stage::Collision, "velocity", "node", i));
@@ -525,6 +557,8 @@ impl Solver {
                 dt,
                 time: state.time,
                 pass,
+                planes: &mut self.s.planes,
+                ties: &mut self.s.ties,
             });
             collision_time += tc.elapsed();
             if let Some(i) = first_non_finite_v(&self.s.vel) {
@@ -642,6 +676,7 @@ impl Solver {
             resize(v, ne, 0.0);
         }
         resize(&mut s.cg_y, n, z);
+        resize(&mut s.planes, n, atelier_collide::ContactPlane::default());
         resize(&mut s.shear, nc, 0.0);
         if self.external_forces.len() != n {
             self.external_forces.clear();
@@ -1371,7 +1406,17 @@ impl Solver {
         let mut cg_total = 0;
         self.s.vel_prev.copy_from_slice(&self.s.vel);
         self.s.lambda_c.fill(0.0);
+        {
+            let s = &mut self.s;
+            s.plane_nodes.clear();
+            s.plane_nodes.extend(
+                (0..s.planes.len() as u32).filter(|&i| s.planes[i as usize].normal != V3::zeros()),
+            );
+        }
         let stiffness = cloth.diagonal_stiffness();
+        // The hard constraints first, so that an iteration that stops at once (the cloth's own
+        // constraints already met) still leaves them met.
+        Self::project(&mut self.s, cloth, state, dt);
         for k in 0..params.shape_max_iterations {
             let s = &mut self.s;
             let (pos, vel, target) = (&state.positions, &s.vel, &s.target);
@@ -1522,14 +1567,54 @@ impl Solver {
                     std::mem::swap(&mut s.vel, &mut s.vel_hat);
                 }
             }
-            for pin in cloth.pins() {
-                let i = pin.node as usize;
-                let v = (pin.position(state.time + dt) - state.positions[i]) / dt;
-                s.vel[i] = v;
-                s.vel_prev[i] = v;
-            }
+            Self::project(s, cloth, state, dt);
         }
         (iterations, residual, cg_total)
+    }
+
+    /// The hard constraints every shape iteration ends with: pins at their prescribed
+    /// positions, ties (a pair farther apart than its length drawn together along its line,
+    /// each node by its share of the inverse mass: momentum kept), and contact planes (no node
+    /// ends the step behind its plane), in that order.
+    fn project(s: &mut Scratch, cloth: &Cloth, state: &ClothState, dt: f64) {
+        let inv = cloth.inverse_masses();
+        for pin in cloth.pins() {
+            let i = pin.node as usize;
+            let v = (pin.position(state.time + dt) - state.positions[i]) / dt;
+            s.vel[i] = v;
+            s.vel_prev[i] = v;
+        }
+        for tie in &s.ties {
+            let (a, b) = (tie.a as usize, tie.b as usize);
+            let ws = inv[a] + inv[b];
+            if ws <= 0.0 {
+                continue;
+            }
+            let gap = (state.positions[b] + s.vel[b] * dt) - (state.positions[a] + s.vel[a] * dt);
+            let l = gap.norm();
+            if l <= tie.length {
+                continue;
+            }
+            let shift = gap * ((l - tie.length) / (l * ws * dt));
+            s.vel[a] += shift * inv[a];
+            s.vel[b] -= shift * inv[b];
+        }
+        for &i in &s.plane_nodes {
+            let (i, plane) = (i as usize, s.planes[i as usize]);
+            let d = (state.positions[i] + s.vel[i] * dt - plane.point).dot(&plane.normal);
+            if d < 0.0 {
+                // Push out along the normal; Coulomb friction takes up to ρ times that change
+                // off the velocity relative to the body, along the plane.
+                let dn = -d / dt;
+                s.vel[i] += plane.normal * dn;
+                let rel = s.vel[i] - plane.velocity;
+                let tangential = rel - plane.normal * rel.dot(&plane.normal);
+                let t = tangential.norm();
+                if t > 0.0 {
+                    s.vel[i] -= tangential * ((plane.friction * dn).min(t) / t);
+                }
+            }
+        }
     }
 
     /// One Gauss–Newton step on the shape objective E^e = ½ Σ (l − l_target)² (49): the

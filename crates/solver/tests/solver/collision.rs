@@ -144,7 +144,8 @@ fn walking_skirt(
         solver
             .step_with(&cloth, &mut state, &params, &mut contact)
             .map_err(|e| format!("step {k}: {e}"))?;
-        contacts += contact.take_stats().body_hits;
+        let stats = contact.take_stats();
+        contacts += stats.body_hits + stats.planes;
         let mut inside = vec![false; state.positions.len()];
         for ((range, _), d) in parts.iter().zip(&mut distance) {
             d.update(&b.positions[range.clone()]).expect("update");
