@@ -9,7 +9,8 @@
 //!   facing direction (0° = front, +z; 90° = the wearer's left, +x), pattern y becomes height.
 //! - [`Placement::Limb`]: a circular cylinder about a limb's rest axis (an upper arm from its
 //!   pivot to its child's), fitted to that limb's band; pattern y runs down the limb from the
-//!   joint, pattern x is arc length from the limb's outer side.
+//!   joint, pattern x is arc length from the limb's outer side, +x to the right of a viewer
+//!   outside the limb (towards the back on the wearer's left arm, the front on the right).
 //!
 //! Seams then close along the chords between the wrapped edges; a garment panel seen from the
 //! outside keeps its pattern orientation (pattern +x to the viewer's right).
@@ -158,25 +159,60 @@ pub fn place(
             }
         }
         let bins = (((hi - lo) / BIN).ceil() as usize).max(1) + 1;
+        let edges = g.cloth.topology().edges();
         let height = |b: usize| lo + b as f64 * BIN;
-        // The panels' total width per bin (each panel's x extent among its nodes in the bin).
-        let mut width = vec![0.0; bins];
-        for &k in &trunk {
-            let mut ext = vec![(f64::INFINITY, f64::NEG_INFINITY); bins];
-            for i in range(k) {
-                let b = ((node_y(k, i) - lo) / BIN).round() as usize;
-                let e = &mut ext[b.min(bins - 1)];
-                *e = (e.0.min(rest[i][0]), e.1.max(rest[i][0]));
-            }
-            for (w, e) in width.iter_mut().zip(&ext) {
-                if e.1 > e.0 {
-                    *w += e.1 - e.0;
+        // Panels go around the body in rings (a bodice's panels side by side, a skirt's below
+        // them): panels whose heights overlap by more than a bin are in one ring. The width the
+        // wrap needs at a height is the largest ring's total width there (each panel's x extent
+        // among its nodes in the bin), so panels that only meet at a height (a waist seam) do
+        // not add up.
+        let span = |k: usize| {
+            range(k).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), i| {
+                (a.min(node_y(k, i)), b.max(node_y(k, i)))
+            })
+        };
+        let mut ring: Vec<usize> = (0..trunk.len()).collect();
+        for x in 0..trunk.len() {
+            for y in 0..x {
+                let (sx, sy) = (span(trunk[x]), span(trunk[y]));
+                if sx.1.min(sy.1) - sx.0.max(sy.0) > BIN {
+                    let (rx, ry) = (ring[x], ring[y]);
+                    ring.iter_mut().filter(|r| **r == rx).for_each(|r| *r = ry);
                 }
             }
         }
-        // Widths at bins without nodes of a panel (its top or bottom) borrow the neighbours'.
-        for b in 1..bins {
-            width[b] = width[b].max(0.5 * width[b - 1]);
+        let mut width = vec![0.0; bins];
+        for r in 0..trunk.len() {
+            let mut ring_width = vec![0.0; bins];
+            for (_, &k) in trunk.iter().enumerate().filter(|(x, _)| ring[*x] == r) {
+                // The panel's extent at each bin's height: the x range where its edges cross
+                // that height (the outline's width there; grid rows need not be level).
+                let mut ext = vec![(f64::INFINITY, f64::NEG_INFINITY); bins];
+                let nodes = range(k);
+                for e in edges.iter().filter(|e| nodes.contains(&(e.a as usize))) {
+                    let (a, b) = (e.a as usize, e.b as usize);
+                    let (ya, yb) = (node_y(k, a), node_y(k, b));
+                    let first = ((ya.min(yb) - lo) / BIN).ceil().max(0.0) as usize;
+                    let last = (((ya.max(yb) - lo) / BIN).floor() as usize).min(bins - 1);
+                    for (bin, e) in ext.iter_mut().enumerate().take(last + 1).skip(first) {
+                        let t = if yb == ya {
+                            0.0
+                        } else {
+                            (height(bin) - ya) / (yb - ya)
+                        };
+                        let x = rest[a][0] + (rest[b][0] - rest[a][0]) * t;
+                        *e = (e.0.min(x), e.1.max(x));
+                    }
+                }
+                for (w, e) in ring_width.iter_mut().zip(&ext) {
+                    if e.1 > e.0 {
+                        *w += e.1 - e.0;
+                    }
+                }
+            }
+            for (w, rw) in width.iter_mut().zip(&ring_width) {
+                *w = f64::max(*w, *rw);
+            }
         }
         let trunk_vertices: Vec<V3> = body
             .vertices
@@ -261,7 +297,9 @@ pub fn place(
         // The limb's outer side: away from the body's vertical axis, across the limb.
         let side = V3::new(origin.x.signum(), 0.0, 0.0);
         let out_dir = (side - axis * axis.dot(&side)).normalize();
-        let front = axis.cross(&out_dir) * origin.x.signum();
+        // Seen from outside the limb (looking along −out_dir, pattern y up the limb, i.e. along
+        // −axis), the pattern's +x runs to the viewer's right: (−out_dir) × (−axis).
+        let plus_x = out_dir.cross(&axis);
         let limb_vertices: Vec<V3> = body
             .vertices
             .iter()
@@ -288,7 +326,7 @@ pub fn place(
                 .fold(0.0, f64::max);
             let radius = (fit + params.clearance).max(from_width);
             let a = rest[i][0] / radius;
-            out[i] = origin + axis * t + (out_dir * a.cos() + front * a.sin()) * radius;
+            out[i] = origin + axis * t + (out_dir * a.cos() + plus_x * a.sin()) * radius;
         }
     }
     Ok(out)
