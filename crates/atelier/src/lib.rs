@@ -13,8 +13,12 @@ pub mod place;
 pub mod report;
 pub mod run;
 pub mod scenario;
+pub mod scene;
 pub mod sewing;
+pub mod simulation;
 pub mod validate;
 
 pub use assemble::{AssembleError, GarmentCloth};
+pub use scene::{Garment, GarmentSpec, Scene, SceneError, Settings};
 pub use sewing::{Chain, Sewing, SewingParams};
+pub use simulation::{Phase, Simulation, SimulationError, StepOutcome};

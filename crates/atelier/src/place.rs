@@ -35,6 +35,23 @@ pub enum Placement {
         #[serde(default)]
         x0: f64,
     },
+    /// Laid flat in a plane facing the body's front, for dressing through the body with
+    /// one-sided contact (thesis §5.6): pattern x along world x, pattern y up, then turned
+    /// about z and moved so that the pattern's origin is at `at`.
+    Flat {
+        /// World position of the pattern's origin (x, y, z), m.
+        at: [f64; 3],
+        /// Laid face down (a back panel, its outside facing −z): pattern x mirrored.
+        #[serde(default)]
+        back: bool,
+        /// Turn about +z, degrees (a sleeve laid along an arm).
+        #[serde(default)]
+        angle_deg: f64,
+        /// Folded along a line of constant pattern x (a sleeve's two halves, one in front of
+        /// the limb and one behind it).
+        #[serde(default)]
+        fold: Option<Fold>,
+    },
     /// Wrapped around a limb.
     Limb {
         /// Body part whose axis (pivot to its child's pivot) the panel wraps (`upper_arm_left` …).
@@ -45,6 +62,28 @@ pub enum Placement {
         #[serde(default)]
         offset: f64,
     },
+}
+
+/// A fold of a flat-laid panel along the line pattern x = `at`: the part beyond it (on `side`)
+/// is turned over about that line and laid `gap` behind the rest.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fold {
+    /// Pattern x of the fold line, m.
+    pub at: f64,
+    /// The side laid behind: `Plus` (x > at) or `Minus` (x < at).
+    pub side: Side,
+    /// Distance between the two layers, m.
+    pub gap: f64,
+}
+
+/// A side of a fold line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Side {
+    /// Pattern x greater than the fold's.
+    Plus,
+    /// Pattern x less than the fold's.
+    Minus,
 }
 
 /// Clearance and ease of the wrap.
@@ -136,6 +175,18 @@ pub fn place(
         let values = match p {
             Placement::Trunk { facing_deg, y0, x0 } => vec![*facing_deg, *y0, *x0],
             Placement::Limb { y0, offset, .. } => vec![*y0, *offset],
+            Placement::Flat {
+                at,
+                angle_deg,
+                fold,
+                ..
+            } => {
+                let mut v = vec![at[0], at[1], at[2], *angle_deg];
+                if let Some(f) = fold {
+                    v.extend([f.at, f.gap]);
+                }
+                v
+            }
         };
         if let Some(&value) = values.iter().find(|v| !v.is_finite()) {
             return Err(PlaceError::NotFinite { panel: k, value });
@@ -149,7 +200,7 @@ pub fn place(
     if !trunk.is_empty() {
         let node_y = |k: usize, i: usize| match placements[k] {
             Placement::Trunk { y0, .. } => y0 + rest[i][1],
-            Placement::Limb { .. } => 0.0,
+            Placement::Limb { .. } | Placement::Flat { .. } => 0.0,
         };
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for &k in &trunk {
@@ -277,6 +328,36 @@ pub fn place(
                 let (x, z) = e.at_arc(facing_deg.to_radians(), rest[i][0] - x0);
                 out[i] = V3::new(x, y, z);
             }
+        }
+    }
+    for (k, p) in placements.iter().enumerate() {
+        let Placement::Flat {
+            at,
+            back,
+            angle_deg,
+            fold,
+        } = p
+        else {
+            continue;
+        };
+        let (sin, cos) = angle_deg.to_radians().sin_cos();
+        for i in range(k) {
+            let (mut x, y) = (rest[i][0], rest[i][1]);
+            let mut z = at[2];
+            if let Some(f) = fold {
+                let beyond = match f.side {
+                    Side::Plus => x > f.at,
+                    Side::Minus => x < f.at,
+                };
+                if beyond {
+                    x = 2.0 * f.at - x;
+                    z -= f.gap;
+                }
+            }
+            if *back {
+                x = -x;
+            }
+            out[i] = V3::new(at[0] + x * cos - y * sin, at[1] + x * sin + y * cos, z);
         }
     }
     for (k, p) in placements.iter().enumerate() {

@@ -31,6 +31,9 @@ pub struct ScenarioInfo {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StageSeconds {
+    /// Posing the body and its parts' motion (garment scenes with a motion).
+    #[serde(default)]
+    pub body: f64,
     /// Normals, curvature, bending force.
     pub bending: f64,
     /// Internal forces.
@@ -43,8 +46,11 @@ pub struct StageSeconds {
     pub shape: f64,
     /// Collision passes (body, self, sewing pull).
     pub collision: f64,
-    /// Position update, hysteresis, diagnostics.
+    /// Position update, hysteresis, the solver's diagnostics.
     pub update: f64,
+    /// The run's own diagnostics after each step (garment scenes: every node against the body).
+    #[serde(default)]
+    pub diagnostics: f64,
     /// Sum of the stages.
     pub total: f64,
 }
@@ -118,8 +124,9 @@ impl Report {
     /// The report of a simulation (outputs and setup time filled in by the runner).
     pub fn new(scenario: &Scenario, file: Option<&Path>, sim: &Simulated) -> Self {
         let expectations = check_expectations(scenario, &sim.metrics);
-        let t = &sim.timings;
+        let t = &sim.timings.solver;
         let stage_s = StageSeconds {
+            body: sim.timings.body.as_secs_f64(),
             bending: t.bending.as_secs_f64(),
             internal: t.internal.as_secs_f64(),
             velocity: t.velocity.as_secs_f64(),
@@ -127,7 +134,8 @@ impl Report {
             shape: t.shape.as_secs_f64(),
             collision: t.collision.as_secs_f64(),
             update: t.update.as_secs_f64(),
-            total: t.total().as_secs_f64(),
+            diagnostics: sim.timings.diagnostics.as_secs_f64(),
+            total: sim.timings.total().as_secs_f64(),
         };
         Self {
             format: Self::FORMAT.into(),

@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::scenes::DrapeScene;
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StageTimings, StepParams};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
 use nalgebra::Vector3;
 
 use crate::export::{
@@ -30,6 +30,7 @@ use crate::report::{ExpectationResult, Report};
 use crate::scenario::{
     CantileverSpec, CatenarySpec, DrapeSpec, Scenario, ScenarioKind, StripDirection, Tester,
 };
+use crate::simulation::Timings;
 
 /// Why a scenario could not be run or its outputs not written. (A run that diverges is not an
 /// error: it is a [`Simulated`] with a failure, and its outputs are written.)
@@ -80,7 +81,7 @@ pub struct Simulated {
     /// Wall time of the steps, s.
     pub wall_seconds: f64,
     /// Wall time per stage, summed over the steps.
-    pub timings: StageTimings,
+    pub timings: Timings,
     /// Metrics by name (see [`ScenarioKind::metric_names`]); `None` when not measured (for
     /// example a drape coefficient after a failed step).
     pub metrics: BTreeMap<String, Option<f64>>,
@@ -381,18 +382,8 @@ fn to_y_up(p: &Vector3<f64>) -> [f64; 3] {
     [p.x, p.z, -p.y]
 }
 
-fn add_timings(sum: &mut StageTimings, t: &StageTimings) {
-    sum.bending += t.bending;
-    sum.internal += t.internal;
-    sum.velocity += t.velocity;
-    sum.shape += t.shape;
-    sum.collision += t.collision;
-    sum.transfer += t.transfer;
-    sum.update += t.update;
-}
-
 fn garment(
-    spec: &crate::pipeline::GarmentSpec,
+    spec: &crate::scene::GarmentSpec,
     base: &Path,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Simulated, RunError> {
@@ -425,9 +416,14 @@ fn garment(
     );
     put("sewn_at_s", run.sewn_at.map(round_time));
     put("max_penetration_m", Some(run.max_penetration));
+    put(
+        "steps_with_penetration",
+        Some(run.steps_with_penetration as f64),
+    );
     put("max_strain_error", Some(run.max_strain_error.0));
     put("final_strain_error", Some(run.max_strain_error.1));
     put("kinetic_energy_j", Some(run.kinetic_energy));
+    put("max_motion_kinetic_energy_j", Some(run.max_motion_energy));
     put("lowest_node_m", lowest);
     Ok(Simulated {
         fabric: String::new(),
@@ -439,7 +435,7 @@ fn garment(
             motion: body,
         }),
         steps: run.steps,
-        dt: spec.dt,
+        dt: spec.settings.dt,
         simulated: last,
         wall_seconds: run.wall_seconds,
         timings: run.timings,
@@ -457,7 +453,7 @@ struct Stepper {
     next_frame: f64,
     steps: usize,
     wall: Duration,
-    timings: StageTimings,
+    timings: Timings,
     max_strain_error: f64,
     max_speed: f64,
     failure: Option<String>,
@@ -474,7 +470,7 @@ impl Stepper {
             next_frame: state.time + interval,
             steps: 0,
             wall: Duration::ZERO,
-            timings: StageTimings::default(),
+            timings: Timings::default(),
             max_strain_error: 0.0,
             max_speed: 0.0,
             failure: None,
@@ -498,7 +494,10 @@ impl Stepper {
         match result {
             Ok(r) => {
                 self.steps += 1;
-                add_timings(&mut self.timings, &r.timings);
+                self.timings.add(&Timings {
+                    solver: r.timings,
+                    ..Timings::default()
+                });
                 self.max_strain_error = self.max_strain_error.max(r.max_strain_error);
                 self.max_speed = r.max_speed;
                 if state.time + 1e-9 * params.dt >= self.next_frame {

@@ -21,7 +21,7 @@ use atelier_fabric::{AnisotropyForm, ErrorKind, FileError, InvalidValue};
 use atelier_solver::StepParams;
 use serde::{Deserialize, Serialize};
 
-use crate::pipeline::GarmentSpec;
+use crate::scene::GarmentSpec;
 
 /// One scenario file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -90,9 +90,11 @@ impl ScenarioKind {
                 "sewn_at_s",
                 "simulated_s",
                 "max_penetration_m",
+                "steps_with_penetration",
                 "max_strain_error",
                 "final_strain_error",
                 "kinetic_energy_j",
+                "max_motion_kinetic_energy_j",
                 "lowest_node_m",
                 "frames",
             ],
@@ -407,7 +409,7 @@ impl Scenario {
             }
         };
         match &self.kind {
-            ScenarioKind::Garment(_) => {}
+            ScenarioKind::Garment(g) => g.settings.check().map_err(|e| e.within("kind"))?,
             ScenarioKind::Drape(d) => {
                 if let Some(dt) = d.dt {
                     positive("kind.dt", dt)?;

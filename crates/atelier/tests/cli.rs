@@ -139,7 +139,7 @@ fn skirt_scenario() -> String {
             Trunk(facing_deg: 180.0, y0: 0.98),
             Trunk(facing_deg: 180.0, y0: 0.98),
         ],
-        sew_limit: 0.1,
+        settings: (sew_limit: 0.1),
     ),
 )"#,
         r.display(),

@@ -125,8 +125,8 @@ fn the_skirt_is_sewn_around_the_mannequin_and_hangs_without_entering_it() {
         y0: 0.98,
         x0: 0.0,
     };
-    let spec: atelier::pipeline::GarmentSpec = ron::from_str(&format!(
-        "(garment: \"patterns/dress/skirt.ron\", fabric: \"fabrics/cotton_broad.ron\", placements: {}, settle: 0.5)",
+    let spec: atelier::GarmentSpec = ron::from_str(&format!(
+        "(garment: \"patterns/dress/skirt.ron\", fabric: \"fabrics/cotton_broad.ron\", placements: {}, settings: (settle: 0.5))",
         ron::to_string(&vec![trunk(0.0), trunk(180.0), trunk(180.0)]).expect("ron")
     ))
     .expect("spec");

@@ -37,8 +37,7 @@ pub fn short_skirt(sew_limit: f64) -> String {
             Trunk(facing_deg: 180.0, y0: 0.98),
             Trunk(facing_deg: 180.0, y0: 0.98),
         ],
-        sew_limit: {sew_limit},
-        frame_interval: 0.05,
+        settings: (sew_limit: {sew_limit}, frame_interval: 0.05),
     ),
     expectations: [(metric: "max_penetration_m", max: 0.01), (metric: "pairs_sewn", min: 1000.0)],
 )"#,
@@ -95,13 +94,23 @@ fn a_garment_run_reports_every_field_and_writes_complete_outputs() {
     assert!((report.simulated_s - 0.2).abs() < 1e-9);
     assert!(report.wall_s > 0.0 && report.setup_s >= 0.0);
     let st = report.stage_s;
-    let sum = st.bending + st.internal + st.velocity + st.transfer + st.shape + st.collision;
+    let sum = st.body
+        + st.bending
+        + st.internal
+        + st.velocity
+        + st.transfer
+        + st.shape
+        + st.collision
+        + st.update
+        + st.diagnostics;
     assert!(
-        (sum + st.update - st.total).abs() < 1e-6 && st.total <= report.wall_s + 1e-6,
+        (sum - st.total).abs() < 1e-6 && st.total <= report.wall_s + 1e-6,
         "{st:?} / {}",
         report.wall_s
     );
     assert!(st.collision > 0.0, "the body contact was timed");
+    assert!(st.diagnostics > 0.0, "the penetration check was timed");
+    assert!(st.body == 0.0, "the body stands: no posing");
     // Metrics: every name the kind declares, finite where measured.
     let scenario = Scenario::parse(&short_skirt(0.2), Path::new("t.ron")).expect("scenario");
     for name in scenario.kind.metric_names() {

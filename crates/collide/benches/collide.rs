@@ -164,7 +164,7 @@ fn full_pass(c: &mut Criterion) {
             vel.copy_from_slice(&v0);
             exit.iter_mut().for_each(|e| *e = V3::zeros());
             collider.set_body(&body, &end, &tris, dt).expect("body");
-            collider.transfer(&x, &mut vel, &inv, &mut []);
+            collider.transfer(&x, &mut vel, &inv, &[], &mut []);
             for _ in 0..2 {
                 collider.resolve(
                     ClothView {

@@ -361,6 +361,12 @@ impl Collider {
         }
     }
 
+    /// Turn one-sided contact on or off (the thesis's dressing through the body, then normal
+    /// contact once the garment is on).
+    pub fn set_one_sided(&mut self, on: bool) {
+        self.params.one_sided = on;
+    }
+
     /// Whether any collision work is configured.
     pub fn is_active(&self) -> bool {
         self.body.is_some() || self.parts.is_some() || self.params.self_collision
@@ -371,15 +377,19 @@ impl Collider {
     /// outside, takes on the change of the body's velocity at the nearest body point since the
     /// previous step, so the cloth moves with the body and the physical stage sees a small
     /// relative speed.
+    ///
+    /// `normals` (the cloth's unit node normals, or empty) decide one-sided contact on rigid
+    /// parts: a node whose normal disagrees with the body's gets no plane.
     pub fn transfer(
         &mut self,
         positions: &[V3],
         velocities: &mut [V3],
         inverse_masses: &[f64],
+        normals: &[V3],
         planes: &mut [ContactPlane],
     ) {
         if self.parts.is_some() {
-            self.transfer_parts(positions, velocities, inverse_masses, planes);
+            self.transfer_parts(positions, velocities, inverse_masses, normals, planes);
             return;
         }
         let Some(body) = self.body.as_ref() else {
@@ -452,6 +462,7 @@ impl Collider {
         positions: &[V3],
         velocities: &mut [V3],
         inverse_masses: &[f64],
+        normals: &[V3],
         planes: &mut [ContactPlane],
     ) {
         let Some(parts) = self.parts.as_ref() else {
@@ -480,7 +491,10 @@ impl Collider {
             } else {
                 V3::zeros()
             };
-            let plane = (with_planes && n.distance < p.plane_reach).then(|| {
+            let one_sided_miss = p.one_sided
+                && !normals.is_empty()
+                && normals[i].dot(&parts.place(&n, false).1) <= 0.0;
+            let plane = (with_planes && n.distance < p.plane_reach && !one_sided_miss).then(|| {
                 let (q, normal) = parts.place(&n, true);
                 ContactPlane {
                     point: q + normal * p.thickness,

@@ -61,6 +61,11 @@ impl BodyContact {
         self.collider.set_part_motion(start, end, dt)
     }
 
+    /// Turn one-sided contact on or off.
+    pub fn set_one_sided(&mut self, on: bool) {
+        self.collider.set_one_sided(on);
+    }
+
     /// Counts since the last call.
     pub fn take_stats(&mut self) -> PassStats {
         self.collider.take_stats()
@@ -88,10 +93,16 @@ impl BodyContact {
 
 impl CollisionHook for BodyContact {
     fn transfer(&mut self, ctx: HookContext<'_>) {
+        if self.collider.params().one_sided {
+            self.update_normals(ctx.positions);
+        } else {
+            self.normals.clear();
+        }
         self.collider.transfer(
             ctx.positions,
             ctx.velocities,
             ctx.inverse_masses,
+            &self.normals,
             ctx.planes,
         );
     }

@@ -1,0 +1,450 @@
+//! What a simulation is about: a [`Garment`] (its gridded panels, fabric, placements and seams),
+//! the body that wears it, the motion the body performs, and the [`Settings`] of the physics and
+//! of the schedule — together a [`Scene`]. [`GarmentSpec`] is the same written in a scenario
+//! file, with paths; [`Scene::load`] reads the files it names.
+//!
+//! One garment per scene: the solver steps one cloth of one fabric, and a garment of several
+//! fabrics (or layered garments) would need a cloth with a fabric per panel.
+
+use std::path::{Path, PathBuf};
+
+use atelier_body::kinematics::Body;
+use atelier_body::model::Mannequin;
+use atelier_body::motion::Motion;
+use atelier_fabric::{AnisotropyForm, ErrorKind, Fabric, InvalidValue, STANDARD_GRAVITY};
+use atelier_grid::ImproveParams;
+use atelier_grid::pattern::load_garment;
+use atelier_solver::{ConstraintKind, StepParams};
+use serde::{Deserialize, Serialize};
+
+use crate::place::{PlaceParams, Placement};
+use crate::{GarmentCloth, SewingParams};
+
+/// A garment scene as a scenario file writes it: what to wear (files, placements), on which
+/// body, doing what, and how to simulate it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GarmentSpec {
+    /// Garment file (RON), relative to the scenario's folder.
+    pub garment: PathBuf,
+    /// Fabric file (RON), relative to the scenario's folder.
+    pub fabric: PathBuf,
+    /// One placement per panel, in the garment's panel order.
+    pub placements: Vec<Placement>,
+    /// Clearance and ease of the placement.
+    #[serde(default)]
+    pub place: PlaceParams,
+    /// Body description file (RON); the built-in JIS 9AR mannequin when absent.
+    #[serde(default)]
+    pub body: Option<PathBuf>,
+    /// Motion file (RON) the body performs after the garment has settled; none: stand still.
+    #[serde(default)]
+    pub motion: Option<PathBuf>,
+    /// Physics and schedule.
+    #[serde(default)]
+    pub settings: Settings,
+}
+
+/// How the garment gets onto the body.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Dressing {
+    /// Thesis §5.6: the panels placed around the body, their seams drawn together with gravity
+    /// off and sewn; gravity starts when every pair is sewn.
+    Sewn,
+    /// The thesis's "semi-transparent" dressing (§5.6): the garment laid out and sewn in front
+    /// of the body (gravity off), then pushed through it with one-sided contact — a panel's
+    /// outside passes through the body, its inside catches — until no node is inside the body
+    /// after `push_time`; then gravity starts and contact becomes two-sided.
+    OneSided {
+        /// Acceleration pushing every node towards the body (−z, the body's back), m/s².
+        push: f64,
+        /// Least time of the push, s.
+        push_time: f64,
+        /// Longest time of the push before the run gives up, s.
+        push_limit: f64,
+    },
+}
+
+/// The physics of a garment scene and its schedule: sew (or push), settle, move.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Settings {
+    /// Time step Δt, s. Default 0.01 (the thesis's).
+    pub dt: f64,
+    /// Gravity once the garment is on, m/s² (body frame: y up). Default (0, −9.80665, 0).
+    pub gravity: [f64; 3],
+    /// Static friction ρ against the body. Default 0.3 (the thesis's dress).
+    pub friction: f64,
+    /// Restitution ν against the body. Default 0.1.
+    pub restitution: f64,
+    /// Contact skin, m: cloth nodes are kept this far outside the body. Default 0.003 (nodes
+    /// hold the skin, the flat triangles between them do not: with a skin of 1 mm the body's
+    /// creases showed through 2 cm cells).
+    pub skin: f64,
+    /// Cloth against itself. Default false (the thesis left it out for speed).
+    pub self_collision: bool,
+    /// The staged model of moving bodies (thesis §5.4): the body's motion transferred to the
+    /// cloth near it before the shape constraints. Default true; false: the physical model
+    /// alone.
+    pub staged: bool,
+    /// How the garment gets onto the body. Default `Sewn`.
+    pub dressing: Dressing,
+    /// Sewing pull and threshold.
+    pub sewing: SewingSpec,
+    /// Longest time allowed for sewing (or pushing), s (gravity off). Default 3.
+    pub sew_limit: f64,
+    /// Time under gravity after dressing, before the motion starts, s. Default 1.
+    pub settle: f64,
+    /// Duration of the motion, s (0: no motion). Default 0.
+    pub motion_time: f64,
+    /// Interval between recorded frames, s. Default 0.04 (25 frames per second).
+    pub frame_interval: f64,
+    /// Overrides of the solver's step parameters: damping (air drag), tolerances and iteration
+    /// caps, tolerance policy, methods (Δt and gravity are set by the scene). Default: the
+    /// solver's defaults with compliant shear diagonals.
+    pub step: StepParams,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            dt: 0.01,
+            gravity: [0.0, -STANDARD_GRAVITY, 0.0],
+            friction: 0.3,
+            restitution: 0.1,
+            skin: 3e-3,
+            self_collision: false,
+            staged: true,
+            dressing: Dressing::Sewn,
+            sewing: SewingSpec::default(),
+            sew_limit: 3.0,
+            settle: 1.0,
+            motion_time: 0.0,
+            frame_interval: 0.04,
+            step: StepParams {
+                diagonal_constraint: ConstraintKind::Compliant,
+                ..StepParams::default()
+            },
+        }
+    }
+}
+
+/// The sewing stage's parameters, as written in a scene.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SewingSpec {
+    /// Fraction of a pair's gap closed per second (ω), 1/s. Default 10.
+    pub omega: f64,
+    /// A pair closer than this is sewn, m. Default 0.005.
+    pub threshold: f64,
+    /// Largest closing speed of a pair, m/s. Default 1.
+    pub max_speed: f64,
+}
+
+impl Default for SewingSpec {
+    fn default() -> Self {
+        Self {
+            omega: 10.0,
+            threshold: 5e-3,
+            max_speed: 1.0,
+        }
+    }
+}
+
+impl SewingSpec {
+    /// The sewing hook's parameters.
+    pub fn params(&self) -> SewingParams {
+        SewingParams {
+            omega: self.omega,
+            threshold: self.threshold,
+            max_speed: self.max_speed,
+        }
+    }
+}
+
+impl Settings {
+    /// Every range, with the field's path (`settings.dt`, …) in the error.
+    pub fn check(&self) -> Result<(), InvalidValue> {
+        let rules: [(&str, f64, bool, &str); 12] = [
+            (
+                "dt",
+                self.dt,
+                self.dt > 0.0 && self.dt <= 0.1,
+                "in (0, 0.1] s",
+            ),
+            ("friction", self.friction, self.friction >= 0.0, "≥ 0"),
+            (
+                "restitution",
+                self.restitution,
+                (0.0..=1.0).contains(&self.restitution),
+                "in [0, 1]",
+            ),
+            (
+                "skin",
+                self.skin,
+                (0.0..=0.05).contains(&self.skin),
+                "in [0, 0.05] m",
+            ),
+            ("sew_limit", self.sew_limit, self.sew_limit >= 0.0, "≥ 0 s"),
+            ("settle", self.settle, self.settle >= 0.0, "≥ 0 s"),
+            (
+                "motion_time",
+                self.motion_time,
+                self.motion_time >= 0.0,
+                "≥ 0 s",
+            ),
+            (
+                "frame_interval",
+                self.frame_interval,
+                self.frame_interval > 0.0,
+                "> 0 s",
+            ),
+            (
+                "sewing.omega",
+                self.sewing.omega,
+                self.sewing.omega > 0.0,
+                "> 0 1/s",
+            ),
+            (
+                "sewing.threshold",
+                self.sewing.threshold,
+                self.sewing.threshold > 0.0,
+                "> 0 m",
+            ),
+            (
+                "sewing.max_speed",
+                self.sewing.max_speed,
+                self.sewing.max_speed > 0.0,
+                "> 0 m/s",
+            ),
+            (
+                "gravity",
+                self.gravity.iter().map(|g| g.abs()).fold(0.0, f64::max),
+                self.gravity.iter().all(|g| g.abs() <= 1e3),
+                "each component within ±1000 m/s²",
+            ),
+        ];
+        for (name, value, ok, range) in rules {
+            if !value.is_finite() {
+                return Err(InvalidValue::new(
+                    ErrorKind::NotFinite,
+                    format!("settings.{name}"),
+                    format!("{value}"),
+                ));
+            }
+            if !ok {
+                return Err(InvalidValue::new(
+                    ErrorKind::OutOfRange,
+                    format!("settings.{name}"),
+                    format!("{value} must be {range}"),
+                ));
+            }
+        }
+        if let Dressing::OneSided {
+            push,
+            push_time,
+            push_limit,
+        } = self.dressing
+        {
+            for (name, v) in [
+                ("push", push),
+                ("push_time", push_time),
+                ("push_limit", push_limit),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(InvalidValue::new(
+                        ErrorKind::OutOfRange,
+                        format!("settings.dressing.{name}"),
+                        format!("{v} must be finite and > 0"),
+                    ));
+                }
+            }
+            if push_limit < push_time {
+                return Err(InvalidValue::new(
+                    ErrorKind::Inconsistent,
+                    "settings.dressing.push_limit",
+                    format!("{push_limit} s is shorter than push_time {push_time} s"),
+                ));
+            }
+        }
+        let step = StepParams {
+            dt: self.dt,
+            gravity: self.gravity,
+            ..self.step.clone()
+        };
+        step.validate().map_err(|e| {
+            InvalidValue::new(
+                ErrorKind::OutOfRange,
+                format!("settings.step.{}", e.name),
+                e.to_string(),
+            )
+        })
+    }
+}
+
+/// A garment ready to simulate: its panels gridded and joined into one cloth of its fabric, with
+/// the seams to sew and where each panel starts.
+pub struct Garment {
+    /// The garment's name.
+    pub name: String,
+    /// The cloth and its seam pairs.
+    pub cloth: GarmentCloth,
+    /// The fabric.
+    pub fabric: Fabric,
+    /// One placement per panel.
+    pub placements: Vec<Placement>,
+    /// Clearance and ease of the placement.
+    pub place: PlaceParams,
+}
+
+/// Why a scene could not be set up.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A file could not be read or is invalid (the message names file, position and field).
+    #[error("{0}")]
+    File(String),
+    /// The garment could not be assembled.
+    #[error(transparent)]
+    Assemble(#[from] crate::AssembleError),
+    /// The panels could not be placed.
+    #[error(transparent)]
+    Place(#[from] crate::place::PlaceError),
+    /// A setting is out of range.
+    #[error("{0}")]
+    Invalid(#[from] InvalidValue),
+    /// The body or the contact could not be set up.
+    #[error("{0}")]
+    Body(String),
+}
+
+impl Garment {
+    /// Read a garment file and grid its panels (default improvement), read the fabric, and
+    /// join them into one cloth with the given placements.
+    pub fn load(
+        garment: &Path,
+        fabric: &Path,
+        placements: Vec<Placement>,
+        place: PlaceParams,
+    ) -> Result<Self, SceneError> {
+        let pattern = load_garment(garment, ImproveParams::default())
+            .map_err(|e| SceneError::File(e.to_string()))?;
+        let fabric = Fabric::load(fabric).map_err(|e| SceneError::File(e.to_string()))?;
+        if placements.len() != pattern.panels.len() {
+            return Err(crate::place::PlaceError::Count {
+                placements: placements.len(),
+                panels: pattern.panels.len(),
+            }
+            .into());
+        }
+        let cloth = GarmentCloth::new(&pattern, &fabric, AnisotropyForm::PlateTheory)?;
+        Ok(Self {
+            name: pattern.name,
+            cloth,
+            fabric,
+            placements,
+            place,
+        })
+    }
+}
+
+/// Everything a [`crate::simulation::Simulation`] needs.
+pub struct Scene {
+    /// The garment.
+    pub garment: Garment,
+    /// The body, ready to be posed.
+    pub body: Body,
+    /// The motion performed after the garment has settled, if any.
+    pub motion: Option<Motion>,
+    /// Physics and schedule.
+    pub settings: Settings,
+}
+
+impl Scene {
+    /// A scene from its parts, with the settings checked.
+    pub fn new(
+        garment: Garment,
+        mannequin: Mannequin,
+        motion: Option<Motion>,
+        settings: Settings,
+    ) -> Result<Self, SceneError> {
+        settings.check()?;
+        Ok(Self {
+            garment,
+            body: Body::new(mannequin),
+            motion,
+            settings,
+        })
+    }
+
+    /// Read every file a spec names (relative to `base`) and check its settings.
+    pub fn load(spec: &GarmentSpec, base: &Path) -> Result<Self, SceneError> {
+        spec.settings.check()?;
+        let resolve = |p: &Path| base.join(p);
+        let garment = Garment::load(
+            &resolve(&spec.garment),
+            &resolve(&spec.fabric),
+            spec.placements.clone(),
+            spec.place,
+        )?;
+        let mannequin = match &spec.body {
+            None => atelier_body::build::jis_9ar(),
+            Some(p) => {
+                let d = atelier_body::description::BodyDescription::load(&resolve(p))
+                    .map_err(|e| SceneError::File(e.to_string()))?;
+                Mannequin::from_description(&d, &d.sizes)
+                    .map_err(|e| SceneError::File(format!("{}: {e}", p.display())))?
+            }
+        };
+        let motion = match &spec.motion {
+            Some(p) if spec.settings.motion_time > 0.0 => Some(
+                Motion::load(&resolve(p), &mannequin)
+                    .map_err(|e| SceneError::File(e.to_string()))?,
+            ),
+            _ => None,
+        };
+        Self::new(garment, mannequin, motion, spec.settings.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_name_the_field_out_of_range() {
+        let bad = Settings {
+            friction: -0.1,
+            ..Settings::default()
+        };
+        let e = bad.check().expect_err("negative friction");
+        assert_eq!(e.field, "settings.friction");
+        let bad = Settings {
+            step: StepParams {
+                shape_max_iterations: 0,
+                ..Settings::default().step
+            },
+            ..Settings::default()
+        };
+        let e = bad.check().expect_err("no iterations");
+        assert_eq!(e.field, "settings.step.shape_max_iterations");
+        let bad = Settings {
+            dressing: Dressing::OneSided {
+                push: 5.0,
+                push_time: 1.0,
+                push_limit: 0.5,
+            },
+            ..Settings::default()
+        };
+        assert_eq!(
+            bad.check().expect_err("limit").kind,
+            ErrorKind::Inconsistent
+        );
+        let bad = Settings {
+            dt: f64::NAN,
+            ..Settings::default()
+        };
+        assert_eq!(bad.check().expect_err("NaN").kind, ErrorKind::NotFinite);
+        assert!(Settings::default().check().is_ok());
+    }
+}

@@ -1,0 +1,543 @@
+//! A garment scene stepped through time: [`Simulation::step`] advances one Δt through the
+//! ordered stages of `architecture.md`, each timed, each skipped when the scene does not need
+//! it:
+//!
+//! 1. body pose at t and t + Δt and the parts' motion (`body`; skipped while the body stands);
+//! 2. bending force, 3. internal forces, 4. unconstrained velocity (`solver`);
+//! 5. sewing ties and the geometric transfer of body motion with the contact planes (`collide`;
+//!    the transfer only while the body moves);
+//! 6. shape-constraint iterations, 7. collision passes (body, self when on; sewn points held),
+//!    8. repeated as the step parameters say;
+//! 9. position and hysteresis update (`solver`), then the diagnostics: how deep any node is
+//!    inside the body.
+//!
+//! Around the step runs the dressing schedule (thesis §5.6), in phases: sewing with gravity off
+//! (or, for one-sided dressing, sewing in front of the body and then pushing the garment
+//! through it), settling under gravity, then the motion. A step that fails (a non-finite value,
+//! a diverging edge) returns the error with the phase, the time, the stage and the node or edge,
+//! and leaves the state as it was before the step: the last good state.
+
+use std::time::{Duration, Instant};
+
+use atelier_body::kinematics::Posed;
+use atelier_body::model::LabelledMesh;
+use atelier_body::motion::PoseRate;
+use atelier_collide::parts::Motion as PartMotion;
+use atelier_collide::{ContactMaterial, ContactParams, RigidParts, V3};
+use atelier_solver::{
+    BodyContact, ClothState, Solver, StageTimings, StepError, StepParams, StepReport,
+};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::place::place;
+use crate::scene::{Dressing, Scene, SceneError};
+use crate::{Chain, Sewing};
+
+/// The phase of the dressing schedule a step belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Phase {
+    /// Seams being drawn together, gravity off.
+    Sewing,
+    /// One-sided dressing: the sewn garment pushed through the body, gravity off.
+    Pushing,
+    /// Dressed, under gravity, body still.
+    Settling,
+    /// The body moves.
+    Motion,
+    /// The schedule is over (or could not go on: see the warnings).
+    Done,
+}
+
+/// Wall time of a run's stages, summed over its steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Posing the body and setting the parts' motion.
+    pub body: Duration,
+    /// The solver's stages (bending … update; sewing and contact inside transfer/collision).
+    pub solver: StageTimings,
+    /// Diagnostics after the step (penetration of every node).
+    pub diagnostics: Duration,
+}
+
+impl Timings {
+    /// Sum of every stage.
+    pub fn total(&self) -> Duration {
+        self.body + self.solver.total() + self.diagnostics
+    }
+
+    /// Add another run's (or step's) timings.
+    pub fn add(&mut self, t: &Timings) {
+        self.body += t.body;
+        self.diagnostics += t.diagnostics;
+        let (s, o) = (&mut self.solver, &t.solver);
+        s.bending += o.bending;
+        s.internal += o.internal;
+        s.velocity += o.velocity;
+        s.transfer += o.transfer;
+        s.shape += o.shape;
+        s.collision += o.collision;
+        s.update += o.update;
+    }
+}
+
+/// A step that failed; the state is the last good one.
+#[derive(Debug, thiserror::Error)]
+#[error("{phase:?} phase, time {time:.3} s: {source}")]
+pub struct SimulationError {
+    /// The phase it happened in.
+    pub phase: Phase,
+    /// Simulated time at the start of the step, s.
+    pub time: f64,
+    /// What went wrong.
+    pub source: Failure,
+}
+
+/// What made a step fail.
+#[derive(Debug, thiserror::Error)]
+pub enum Failure {
+    /// The cloth step: the stage and the node or edge that went non-finite or diverged.
+    #[error(transparent)]
+    Step(#[from] StepError),
+    /// The body stage: the motion gave a pose the contact refused (a non-finite part motion).
+    #[error("body stage: {0}")]
+    Body(String),
+}
+
+/// What one step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepOutcome {
+    /// The phase of the step.
+    pub phase: Phase,
+    /// The solver's diagnostics.
+    pub report: StepReport,
+    /// Nodes inside the body after the step.
+    pub inside: usize,
+    /// The deepest of them, m (0 when none).
+    pub depth: f64,
+    /// Wall time of the step's stages.
+    pub timings: Timings,
+}
+
+/// A garment scene being simulated.
+pub struct Simulation {
+    scene: Scene,
+    state: ClothState,
+    solver: Solver,
+    sewing: Sewing,
+    contact: BodyContact,
+    params: StepParams,
+    phase: Phase,
+    phase_start: f64,
+    rest: LabelledMesh,
+    /// The body at the start and the end of the coming step.
+    posed: Posed,
+    next_posed: Posed,
+    motion_start: Vec<PartMotion>,
+    motion_end: Vec<PartMotion>,
+    surface_triangles: Vec<[u32; 3]>,
+    sewn_at: Option<f64>,
+    last_inside: usize,
+    warnings: Vec<String>,
+}
+
+impl Simulation {
+    /// Place the garment around the body and prepare every stage.
+    pub fn new(scene: Scene) -> Result<Self, SceneError> {
+        let g = &scene.garment;
+        let rest = scene.body.rest.clone();
+        let placed = place(
+            &g.cloth,
+            &g.placements,
+            &scene.body.mannequin,
+            &rest,
+            &g.place,
+        )?;
+        let mut state = ClothState::placed(&g.cloth.cloth, |p: [f64; 2]| V3::new(p[0], p[1], 0.0));
+        state.positions.copy_from_slice(&placed);
+        let settings = &scene.settings;
+        let sewing = Sewing::new(g.cloth.pairs.clone(), settings.sewing.params());
+        let one_sided = matches!(settings.dressing, Dressing::OneSided { .. });
+        let contact_params = ContactParams {
+            material: ContactMaterial {
+                restitution: settings.restitution,
+                friction: settings.friction,
+            },
+            self_collision: settings.self_collision,
+            thickness: settings.skin,
+            staged: settings.staged,
+            one_sided,
+            ..ContactParams::default()
+        };
+        let mut contact = BodyContact::new(&g.cloth.cloth, contact_params)
+            .map_err(|e| SceneError::Body(e.to_string()))?;
+        let part_meshes: Vec<(&[V3], &[[u32; 3]])> = scene
+            .body
+            .mannequin
+            .parts
+            .iter()
+            .map(|p| (p.vertices.as_slice(), p.triangles.as_slice()))
+            .collect();
+        let parts =
+            RigidParts::new(&part_meshes).map_err(|e| SceneError::Body(format!("body: {e}")))?;
+        // The continuous test needs only the faces on the body's surface: a face buried in
+        // another part (the parts overlap at the joints) can only be met from inside.
+        let surface_triangles = exposed_triangles(&scene.body.mannequin, &rest, &parts);
+        contact.set_parts(parts);
+        let posed = Posed {
+            positions: rest.vertices.clone(),
+            velocities: vec![V3::zeros(); rest.vertices.len()],
+        };
+        contact
+            .set_body(
+                &posed.positions,
+                &posed.positions,
+                &surface_triangles,
+                settings.dt,
+            )
+            .map_err(|e| SceneError::Body(e.to_string()))?;
+        let still = vec![PartMotion::identity(); scene.body.mannequin.parts.len()];
+        contact
+            .set_part_motion(&still, &still, settings.dt)
+            .map_err(|e| SceneError::Body(e.to_string()))?;
+        let params = StepParams {
+            dt: settings.dt,
+            gravity: [0.0; 3],
+            ..settings.step.clone()
+        };
+        Ok(Self {
+            state,
+            solver: Solver::new(),
+            sewing,
+            contact,
+            params,
+            phase: Phase::Sewing,
+            phase_start: 0.0,
+            next_posed: posed.clone(),
+            posed,
+            motion_start: still.clone(),
+            motion_end: still,
+            rest,
+            surface_triangles,
+            sewn_at: None,
+            last_inside: 0,
+            warnings: Vec::new(),
+            scene,
+        })
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The cloth's state (positions, velocities, forces, hysteresis).
+    pub fn state(&self) -> &ClothState {
+        &self.state
+    }
+
+    /// The phase the next step belongs to.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.state.time
+    }
+
+    /// The body's vertices now (the rest mesh's order).
+    pub fn body_positions(&self) -> &[V3] {
+        &self.posed.positions
+    }
+
+    /// The body's triangles (the rest mesh's).
+    pub fn body_triangles(&self) -> &[[u32; 3]] {
+        &self.rest.triangles
+    }
+
+    /// The cloth's triangles.
+    pub fn cloth_triangles(&self) -> &[[u32; 3]] {
+        self.scene.garment.cloth.cloth.topology().triangles()
+    }
+
+    /// Pairs sewn, of all.
+    pub fn sewing_progress(&self) -> (usize, usize) {
+        self.sewing.progress()
+    }
+
+    /// When every pair was sewn, s.
+    pub fn sewn_at(&self) -> Option<f64> {
+        self.sewn_at
+    }
+
+    /// Things the user should know (seams left open, a push that did not finish).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The longest the schedule can take, s (for progress bars).
+    pub fn planned_time(&self) -> f64 {
+        let s = &self.scene.settings;
+        let push = match s.dressing {
+            Dressing::Sewn => 0.0,
+            Dressing::OneSided { push_limit, .. } => push_limit,
+        };
+        let motion = if self.scene.motion.is_some() {
+            s.motion_time
+        } else {
+            0.0
+        };
+        s.sew_limit + push + s.settle + motion
+    }
+
+    /// Change phase where the schedule says so (before a step).
+    fn advance_phase(&mut self) {
+        let s = &self.scene.settings;
+        let (t, dt) = (self.state.time, s.dt);
+        let elapsed = t - self.phase_start;
+        let due = |limit: f64| elapsed >= limit - 0.5 * dt;
+        match self.phase {
+            Phase::Sewing if self.sewing.done() => {
+                self.sewn_at = Some(t);
+                self.phase_start = t;
+                match s.dressing {
+                    Dressing::Sewn => self.start_settling(),
+                    Dressing::OneSided { push, .. } => {
+                        self.phase = Phase::Pushing;
+                        let masses = self.scene.garment.cloth.cloth.masses();
+                        self.solver.external_forces = masses
+                            .iter()
+                            .map(|m| V3::new(0.0, 0.0, -push * m))
+                            .collect();
+                    }
+                }
+            }
+            Phase::Sewing if due(s.sew_limit) => {
+                self.warnings.push(format!(
+                    "sewing not finished after {:.2} s: {} of {} pairs sewn; open: {}",
+                    s.sew_limit,
+                    self.sewing.progress().0,
+                    self.sewing.progress().1,
+                    open_seams(
+                        &self.sewing,
+                        &self.scene.garment.cloth,
+                        &self.state.positions
+                    )
+                ));
+                self.phase = Phase::Done;
+            }
+            Phase::Pushing => {
+                let Dressing::OneSided {
+                    push_time,
+                    push_limit,
+                    ..
+                } = s.dressing
+                else {
+                    unreachable!("pushing only in one-sided dressing")
+                };
+                if due(push_time) && self.last_inside == 0 {
+                    self.solver.external_forces.clear();
+                    self.contact.set_one_sided(false);
+                    self.phase_start = t;
+                    self.start_settling();
+                } else if due(push_limit) {
+                    self.warnings.push(format!(
+                        "the push did not get the garment through the body in {push_limit:.2} s: {} nodes still inside",
+                        self.last_inside
+                    ));
+                    self.phase = Phase::Done;
+                }
+            }
+            Phase::Settling if due(s.settle) => {
+                if self.scene.motion.is_some() && s.motion_time > 0.0 {
+                    self.phase = Phase::Motion;
+                    self.phase_start = t;
+                } else {
+                    self.phase = Phase::Done;
+                }
+            }
+            Phase::Motion if due(s.motion_time) => self.phase = Phase::Done,
+            _ => {}
+        }
+    }
+
+    fn start_settling(&mut self) {
+        self.phase = Phase::Settling;
+        self.params.gravity = self.scene.settings.gravity;
+    }
+
+    /// One step of Δt through every stage; `Ok(None)` once the schedule is over (nothing is
+    /// done then). On an error the state is the last good one.
+    pub fn step(&mut self) -> Result<Option<StepOutcome>, SimulationError> {
+        self.advance_phase();
+        if self.phase == Phase::Done {
+            return Ok(None);
+        }
+        let (t, dt) = (self.state.time, self.scene.settings.dt);
+        let mut timings = Timings::default();
+        // 1. The body over this step.
+        let moving = self.phase == Phase::Motion;
+        if moving && let Some(m) = &self.scene.motion {
+            let clock = Instant::now();
+            let tm = t - self.phase_start;
+            let (a, b) = (m.sample(tm), m.sample(tm + dt));
+            let body = &self.scene.body;
+            body.pose_into(&a, &mut self.posed);
+            body.pose_into(&b, &mut self.next_posed);
+            part_motions(body, &a, &mut self.motion_start);
+            part_motions(body, &b, &mut self.motion_end);
+            let set = self
+                .contact
+                .set_body(
+                    &self.posed.positions,
+                    &self.next_posed.positions,
+                    &self.surface_triangles,
+                    dt,
+                )
+                .and_then(|()| {
+                    self.contact
+                        .set_part_motion(&self.motion_start, &self.motion_end, dt)
+                });
+            if let Err(e) = set {
+                return Err(SimulationError {
+                    phase: self.phase,
+                    time: t,
+                    source: Failure::Body(e.to_string()),
+                });
+            }
+            timings.body = clock.elapsed();
+        }
+        // 2–9. The cloth step with its hooks: sewing, then the body.
+        let report = {
+            let mut hooks = Chain(vec![&mut self.sewing, &mut self.contact]);
+            self.solver.step_with(
+                &self.scene.garment.cloth.cloth,
+                &mut self.state,
+                &self.params,
+                &mut hooks,
+            )
+        }
+        .map_err(|e| SimulationError {
+            phase: self.phase,
+            time: t,
+            source: Failure::Step(e),
+        })?;
+        timings.solver = report.timings;
+        if moving {
+            std::mem::swap(&mut self.posed, &mut self.next_posed);
+        }
+        // Diagnostics: every node against the body at the end of the step.
+        let clock = Instant::now();
+        let parts = self.contact.parts().expect("set in new");
+        let (inside, depth) = penetration(&self.state.positions, parts);
+        self.last_inside = inside;
+        timings.diagnostics = clock.elapsed();
+        Ok(Some(StepOutcome {
+            phase: self.phase,
+            report,
+            inside,
+            depth,
+            timings,
+        }))
+    }
+}
+
+/// Nodes inside the body (at the end of the step) and the deepest depth, m.
+fn penetration(nodes: &[V3], parts: &RigidParts) -> (usize, f64) {
+    nodes
+        .par_iter()
+        .map(|p| match parts.nearest(p, 0.0, true) {
+            Some(n) if n.distance < 0.0 => (1, -n.distance),
+            _ => (0, 0.0),
+        })
+        .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
+}
+
+/// The rigid motion of every part (rest → world) in a pose, in the mannequin's part order.
+fn part_motions(body: &atelier_body::kinematics::Body, rate: &PoseRate, out: &mut [PartMotion]) {
+    let frames = body.frames(rate);
+    for (m, part) in out.iter_mut().zip(&body.mannequin.parts) {
+        let f = frames[part.part.index()];
+        let r = f.rotation;
+        *m = PartMotion::from_parts((f.pivot - r * part.pivot).into(), r);
+    }
+}
+
+/// The body triangles not buried in another part: a triangle whose three vertices are all more
+/// than 1 mm inside some other part is left out of the continuous test.
+fn exposed_triangles(
+    mannequin: &atelier_body::model::Mannequin,
+    rest: &LabelledMesh,
+    parts: &RigidParts,
+) -> Vec<[u32; 3]> {
+    // Part k of `parts` is `mannequin.parts[k]`.
+    let index_of = |part: atelier_body::model::Part| {
+        mannequin
+            .parts
+            .iter()
+            .position(|p| p.part == part)
+            .expect("every labelled part is a mannequin part")
+    };
+    let buried = |v: u32, own: usize| {
+        let p = rest.vertices[v as usize];
+        (0..parts.len())
+            .filter(|&k| k != own)
+            .any(|k| parts.rest_distance(k, &p) < -1e-3)
+    };
+    rest.triangles
+        .iter()
+        .zip(&rest.triangle_part)
+        .filter(|(t, part)| {
+            let own = index_of(**part);
+            !t.iter().all(|&v| buried(v, own))
+        })
+        .map(|(t, _)| *t)
+        .collect()
+}
+
+/// The seams with open pairs: name, open pairs of all, the widest gap and where it is.
+fn open_seams(sewing: &Sewing, g: &crate::GarmentCloth, positions: &[V3]) -> String {
+    // (name, open, all, widest gap, its midpoint)
+    let mut seams: Vec<(&str, usize, usize, f64, V3)> = Vec::new();
+    let open = sewing.unsewn();
+    for (k, name) in g.pair_names.iter().enumerate() {
+        let idx = match seams.iter().position(|s| s.0 == name) {
+            Some(i) => i,
+            None => {
+                seams.push((name, 0, 0, 0.0, V3::zeros()));
+                seams.len() - 1
+            }
+        };
+        let seam = &mut seams[idx];
+        seam.2 += 1;
+        if open.binary_search(&k).is_ok() {
+            let (a, b) = (
+                positions[g.pairs[k].0 as usize],
+                positions[g.pairs[k].1 as usize],
+            );
+            seam.1 += 1;
+            if (a - b).norm() >= seam.3 {
+                seam.3 = (a - b).norm();
+                seam.4 = (a + b) * 0.5;
+            }
+        }
+    }
+    seams
+        .iter()
+        .filter(|s| s.1 > 0)
+        .map(|s| {
+            format!(
+                "{} ({} of {}, widest {:.1} mm at ({:.3}, {:.3}, {:.3}) m)",
+                s.0,
+                s.1,
+                s.2,
+                s.3 * 1e3,
+                s.4.x,
+                s.4.y,
+                s.4.z
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
