@@ -55,7 +55,9 @@ pub enum Dressing {
     /// The thesis's "semi-transparent" dressing (§5.6): the garment laid out and sewn in front
     /// of the body (gravity off), then pushed through it with one-sided contact — a panel's
     /// outside passes through the body, its inside catches — until no node is inside the body
-    /// after `push_time`; then gravity starts and contact becomes two-sided.
+    /// after `push_time`; then gravity starts and contact becomes two-sided. The contact is
+    /// frictionless until then (pressed on by the push, friction would pin the garment where
+    /// it first touches instead of letting it slide round the body).
     OneSided {
         /// Acceleration pushing every node towards the body (−z, the body's back), m/s².
         push: f64,

@@ -143,14 +143,34 @@ pub struct Simulation {
 
 impl Simulation {
     /// Place the garment around the body and prepare every stage.
+    ///
+    /// The body stands in its motion's first pose (the rest pose without a motion) until the
+    /// motion starts: a motion that starts away from rest (arms held out to dress by one-sided
+    /// contact, then lowered) dresses the body in that pose.
     pub fn new(scene: Scene) -> Result<Self, SceneError> {
         let g = &scene.garment;
         let rest = scene.body.rest.clone();
+        let n_parts = scene.body.mannequin.parts.len();
+        let mut start_pose = vec![PartMotion::identity(); n_parts];
+        let mut posed = Posed {
+            positions: rest.vertices.clone(),
+            velocities: vec![V3::zeros(); rest.vertices.len()],
+        };
+        if let Some(m) = &scene.motion {
+            let first = m.sample(0.0);
+            scene.body.pose_into(&first, &mut posed);
+            posed.velocities.iter_mut().for_each(|v| *v = V3::zeros());
+            part_motions(&scene.body, &first, &mut start_pose);
+        }
+        let standing = LabelledMesh {
+            vertices: posed.positions.clone(),
+            ..rest.clone()
+        };
         let placed = place(
             &g.cloth,
             &g.placements,
             &scene.body.mannequin,
-            &rest,
+            &standing,
             &g.place,
         )?;
         let mut state = ClothState::placed(&g.cloth.cloth, |p: [f64; 2]| V3::new(p[0], p[1], 0.0));
@@ -161,7 +181,9 @@ impl Simulation {
         let contact_params = ContactParams {
             material: ContactMaterial {
                 restitution: settings.restitution,
-                friction: settings.friction,
+                // One-sided dressing slides the garment round the body: frictionless until
+                // gravity starts.
+                friction: if one_sided { 0.0 } else { settings.friction },
             },
             self_collision: settings.self_collision,
             thickness: settings.skin,
@@ -184,10 +206,6 @@ impl Simulation {
         // another part (the parts overlap at the joints) can only be met from inside.
         let surface_triangles = exposed_triangles(&scene.body.mannequin, &rest, &parts);
         contact.set_parts(parts);
-        let posed = Posed {
-            positions: rest.vertices.clone(),
-            velocities: vec![V3::zeros(); rest.vertices.len()],
-        };
         contact
             .set_body(
                 &posed.positions,
@@ -196,9 +214,9 @@ impl Simulation {
                 settings.dt,
             )
             .map_err(|e| SceneError::Body(e.to_string()))?;
-        let still = vec![PartMotion::identity(); scene.body.mannequin.parts.len()];
+        // Standing: the same pose at both ends of the step.
         contact
-            .set_part_motion(&still, &still, settings.dt)
+            .set_part_motion(&start_pose, &start_pose, settings.dt)
             .map_err(|e| SceneError::Body(e.to_string()))?;
         let params = StepParams {
             dt: settings.dt,
@@ -215,8 +233,8 @@ impl Simulation {
             phase_start: 0.0,
             next_posed: posed.clone(),
             posed,
-            motion_start: still.clone(),
-            motion_end: still,
+            motion_start: start_pose.clone(),
+            motion_end: start_pose,
             rest,
             surface_triangles,
             sewn_at: None,
@@ -339,12 +357,14 @@ impl Simulation {
                 if due(push_time) && self.last_inside == 0 {
                     self.solver.external_forces.clear();
                     self.contact.set_one_sided(false);
+                    self.contact.set_friction(s.friction);
                     self.phase_start = t;
                     self.start_settling();
                 } else if due(push_limit) {
                     self.warnings.push(format!(
-                        "the push did not get the garment through the body in {push_limit:.2} s: {} nodes still inside",
-                        self.last_inside
+                        "the push did not get the garment through the body in {push_limit:.2} s: {} nodes still inside ({})",
+                        self.last_inside,
+                        self.inside_by_part()
                     ));
                     self.phase = Phase::Done;
                 }
@@ -440,6 +460,47 @@ impl Simulation {
             depth,
             timings,
         }))
+    }
+}
+
+impl Simulation {
+    /// The nodes inside the body now.
+    pub fn inside_nodes(&self) -> Vec<usize> {
+        let parts = self.contact.parts().expect("set in new");
+        (0..self.state.positions.len())
+            .filter(|&i| {
+                parts
+                    .nearest(&self.state.positions[i], 0.0, true)
+                    .is_some_and(|n| n.distance < 0.0)
+            })
+            .collect()
+    }
+
+    /// The nodes inside the body now, by part: "part: count (deepest mm)", the deepest first.
+    pub fn inside_by_part(&self) -> String {
+        let parts = self.contact.parts().expect("set in new");
+        let names = &self.scene.body.mannequin.parts;
+        let mut by: Vec<(usize, usize, f64)> = Vec::new();
+        for p in &self.state.positions {
+            if let Some(n) = parts.nearest(p, 0.0, true)
+                && n.distance < 0.0
+            {
+                match by.iter_mut().find(|b| b.0 == n.part) {
+                    Some(b) => {
+                        b.1 += 1;
+                        b.2 = b.2.max(-n.distance);
+                    }
+                    None => by.push((n.part, 1, -n.distance)),
+                }
+            }
+        }
+        by.sort_by(|a, b| b.2.total_cmp(&a.2));
+        by.iter()
+            .map(|(k, count, depth)| {
+                format!("{}: {count} ({:.1} mm)", names[*k].part.name(), depth * 1e3)
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }
 

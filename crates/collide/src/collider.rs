@@ -361,6 +361,11 @@ impl Collider {
         }
     }
 
+    /// Change the static friction ρ against the body (and the cloth).
+    pub fn set_friction(&mut self, friction: f64) {
+        self.params.material.friction = friction;
+    }
+
     /// Turn one-sided contact on or off (the thesis's dressing through the body, then normal
     /// contact once the garment is on).
     pub fn set_one_sided(&mut self, on: bool) {
@@ -491,9 +496,11 @@ impl Collider {
             } else {
                 V3::zeros()
             };
+            // One-sided: only where the cloth's inside faces the body, and not for a node deep
+            // inside (one passing through the body from its outside, met its far side).
             let one_sided_miss = p.one_sided
-                && !normals.is_empty()
-                && normals[i].dot(&parts.place(&n, false).1) <= 0.0;
+                && ((!normals.is_empty() && normals[i].dot(&parts.place(&n, false).1) <= 0.0)
+                    || n.distance < -p.recovery_depth);
             let plane = (with_planes && n.distance < p.plane_reach && !one_sided_miss).then(|| {
                 let (q, normal) = parts.place(&n, true);
                 ContactPlane {

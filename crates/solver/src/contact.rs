@@ -61,6 +61,11 @@ impl BodyContact {
         self.collider.set_part_motion(start, end, dt)
     }
 
+    /// Change the static friction ρ.
+    pub fn set_friction(&mut self, friction: f64) {
+        self.collider.set_friction(friction);
+    }
+
     /// Turn one-sided contact on or off.
     pub fn set_one_sided(&mut self, on: bool) {
         self.collider.set_one_sided(on);
