@@ -117,6 +117,8 @@ pub struct StepOutcome {
     pub depth: f64,
     /// Wall time of the step's stages.
     pub timings: Timings,
+    /// The contact counts of the step (continuous-test candidates and hits, transfers, planes).
+    pub contacts: atelier_collide::PassStats,
 }
 
 /// A garment scene being simulated.
@@ -138,6 +140,8 @@ pub struct Simulation {
     surface_triangles: Vec<[u32; 3]>,
     sewn_at: Option<f64>,
     last_inside: usize,
+    /// Cloth positions at the start of the last step (the diagnostics' bound).
+    start_positions: Vec<V3>,
     warnings: Vec<String>,
 }
 
@@ -239,6 +243,7 @@ impl Simulation {
             surface_triangles,
             sewn_at: None,
             last_inside: 0,
+            start_positions: Vec::new(),
             warnings: Vec::new(),
             scene,
         })
@@ -429,6 +434,7 @@ impl Simulation {
             timings.body = clock.elapsed();
         }
         // 2–9. The cloth step with its hooks: sewing, then the body.
+        self.start_positions.clone_from(&self.state.positions);
         let report = {
             let mut hooks = Chain(vec![&mut self.sewing, &mut self.contact]);
             self.solver.step_with(
@@ -450,7 +456,12 @@ impl Simulation {
         // Diagnostics: every node against the body at the end of the step.
         let clock = Instant::now();
         let parts = self.contact.parts().expect("set in new");
-        let (inside, depth) = penetration(&self.state.positions, parts);
+        let (inside, depth) = penetration(
+            &self.state.positions,
+            &self.start_positions,
+            self.contact.start_distances(),
+            parts,
+        );
         self.last_inside = inside;
         timings.diagnostics = clock.elapsed();
         Ok(Some(StepOutcome {
@@ -459,6 +470,7 @@ impl Simulation {
             inside,
             depth,
             timings,
+            contacts: self.contact.take_stats(),
         }))
     }
 }
@@ -504,13 +516,30 @@ impl Simulation {
     }
 }
 
-/// Nodes inside the body (at the end of the step) and the deepest depth, m.
-fn penetration(nodes: &[V3], parts: &RigidParts) -> (usize, f64) {
+/// Nodes inside the body at the end of the step and the deepest depth, m. A node whose
+/// distance at the start of the step (`start_distance`, or a lower bound) exceeds how far it
+/// moved plus how far any body point moved cannot be inside (the distance is 1-Lipschitz) and
+/// is not queried.
+fn penetration(
+    nodes: &[V3],
+    start: &[V3],
+    start_distance: &[f64],
+    parts: &RigidParts,
+) -> (usize, f64) {
+    let body_moved = parts.max_displacement();
     nodes
         .par_iter()
-        .map(|p| match parts.nearest(p, 0.0, true) {
-            Some(n) if n.distance < 0.0 => (1, -n.distance),
-            _ => (0, 0.0),
+        .enumerate()
+        .map(|(i, p)| {
+            if let (Some(d0), Some(x0)) = (start_distance.get(i), start.get(i))
+                && *d0 - (p - x0).norm() - body_moved > 0.0
+            {
+                return (0, 0.0);
+            }
+            match parts.nearest(p, 0.0, true) {
+                Some(n) if n.distance < 0.0 => (1, -n.distance),
+                _ => (0, 0.0),
+            }
         })
         .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
 }

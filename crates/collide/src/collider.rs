@@ -225,6 +225,9 @@ pub struct Collider {
     parts: Option<RigidParts>,
     /// Per node: velocity change and contact plane found by the parts transfer.
     part_results: Vec<Option<(V3, Option<ContactPlane>)>>,
+    /// Per node: its distance to the body at the start of the step as the parts transfer found
+    /// it (negative inside), or a lower bound (the search reach) when it is farther.
+    start_distance: Vec<f64>,
     cloth_broad: Option<Box<dyn BroadPhase>>,
     candidates: Vec<u32>,
     cloth_end: Vec<V3>,
@@ -240,6 +243,7 @@ impl Collider {
             body: None,
             parts: None,
             part_results: Vec::new(),
+            start_distance: Vec::new(),
             cloth_broad: None,
             candidates: Vec::new(),
             cloth_end: Vec::new(),
@@ -343,6 +347,13 @@ impl Collider {
     /// The rigid parts, if set.
     pub fn parts(&self) -> Option<&RigidParts> {
         self.parts.as_ref()
+    }
+
+    /// Each node's distance to the body at the start of the last step as the parts transfer
+    /// found it (negative inside), or a lower bound when it was beyond the search's reach; empty
+    /// without rigid parts.
+    pub fn start_distances(&self) -> &[f64] {
+        &self.start_distance
     }
 
     /// The parts' motion over the coming step (rest → world at its start and end).
@@ -475,53 +486,67 @@ impl Collider {
         };
         let p = self.params;
         let with_planes = p.plane_reach > 0.0 && !planes.is_empty();
-        let reach = if p.staged {
+        // The body's motion reaches as far as it moves plus the margin; a still body has none to
+        // transfer, and only the planes' reach is searched.
+        let transfer = p.staged && !parts.is_still();
+        let reach = if transfer {
             (parts.max_displacement() + p.transfer_margin).max(p.plane_reach)
-        } else if with_planes {
-            p.plane_reach
         } else {
-            return;
+            p.plane_reach
         };
         self.part_results.clear();
         self.part_results.resize(positions.len(), None);
-        let find = |(i, out): (usize, &mut Option<(V3, Option<ContactPlane>)>)| {
-            if inverse_masses[i] == 0.0 {
-                return;
-            }
-            let Some(n) = parts.nearest(&positions[i], reach, false) else {
-                return;
-            };
-            let dv = if p.staged && n.distance >= -p.thickness {
-                parts.velocity_change(&n)
-            } else {
-                V3::zeros()
-            };
-            // One-sided: only where the cloth's inside faces the body, and not for a node deep
-            // inside (one passing through the body from its outside, met its far side).
-            let one_sided_miss = p.one_sided
-                && ((!normals.is_empty() && normals[i].dot(&parts.place(&n, false).1) <= 0.0)
-                    || n.distance < -p.recovery_depth);
-            let plane = (with_planes && n.distance < p.plane_reach && !one_sided_miss).then(|| {
-                let (q, normal) = parts.place(&n, true);
-                ContactPlane {
-                    point: q + normal * p.thickness,
-                    normal,
-                    velocity: parts.velocity(&n),
-                    friction: p.material.friction,
+        self.start_distance.clear();
+        self.start_distance.resize(positions.len(), reach);
+        let find =
+            |(i, (out, dist)): (usize, (&mut Option<(V3, Option<ContactPlane>)>, &mut f64))| {
+                if inverse_masses[i] == 0.0 {
+                    return;
                 }
-            });
-            *out = Some((dv, plane));
-        };
+                let Some(n) = parts.nearest(&positions[i], reach, false) else {
+                    return;
+                };
+                *dist = n.distance;
+                let dv = if transfer && n.distance >= -p.thickness {
+                    parts.velocity_change(&n)
+                } else {
+                    V3::zeros()
+                };
+                // One-sided: only where the cloth's inside faces the body, and not for a node deep
+                // inside (one passing through the body from its outside, met its far side).
+                let one_sided_miss = p.one_sided
+                    && ((!normals.is_empty() && normals[i].dot(&parts.place(&n, false).1) <= 0.0)
+                        || n.distance < -p.recovery_depth);
+                let plane =
+                    (with_planes && n.distance < p.plane_reach && !one_sided_miss).then(|| {
+                        let (q, normal) = parts.place(&n, true);
+                        ContactPlane {
+                            point: q + normal * p.thickness,
+                            normal,
+                            velocity: parts.velocity(&n),
+                            friction: p.material.friction,
+                        }
+                    });
+                *out = Some((dv, plane));
+            };
         if positions.len() >= 256 {
-            self.part_results.par_iter_mut().enumerate().for_each(find);
+            self.part_results
+                .par_iter_mut()
+                .zip(self.start_distance.par_iter_mut())
+                .enumerate()
+                .for_each(find);
         } else {
-            self.part_results.iter_mut().enumerate().for_each(find);
+            self.part_results
+                .iter_mut()
+                .zip(self.start_distance.iter_mut())
+                .enumerate()
+                .for_each(find);
         }
         for (i, r) in self.part_results.iter().enumerate() {
             let Some((dv, plane)) = r else {
                 continue;
             };
-            if p.staged {
+            if transfer {
                 velocities[i] += dv;
                 self.stats.transferred += 1;
             }
@@ -534,7 +559,10 @@ impl Collider {
 
     /// One physical collision pass: every free node against the body's triangles (moving from
     /// start to end) and, with self-collision, against the cloth's triangles that do not contain
-    /// it. Nodes are visited in index order; each takes its earliest contact.
+    /// it. Each node takes its earliest contact, then the next, up to three. With self-collision
+    /// nodes are visited in index order (a contact changes the triangle's vertices too); without
+    /// it every node's contacts depend on that node alone and the nodes are resolved in parallel
+    /// (the same result as in order).
     pub fn resolve(&mut self, cloth: ClothView<'_>, dt: f64) {
         if !self.is_active() || dt <= 0.0 {
             return;
@@ -550,138 +578,253 @@ impl Collider {
         } = cloth;
         let n = positions.len();
         let p = self.params;
-        let test = match p.narrow {
-            NarrowTest::Exact => point_triangle,
-            NarrowTest::Thesis => point_triangle_thesis,
-        };
         if p.self_collision {
             self.cloth_end.clear();
             self.cloth_end
                 .extend((0..n).map(|i| positions[i] + velocities[i] * dt));
             let broad = self.cloth_broad.get_or_insert_with(|| new_broad(p.broad));
             broad.update(positions, &self.cloth_end, triangles, p.thickness);
-        }
-        for i in 0..n {
-            if inverse_masses[i] == 0.0 {
-                continue;
-            }
-            // Up to MAX_CONTACTS contacts per node and pass, each against a surface not met yet
-            // (a node in a crease between two parts meets both).
-            let mut met: [(usize, bool); MAX_CONTACTS] = [(usize::MAX, false); MAX_CONTACTS];
-            for round in 0..MAX_CONTACTS {
-                let (pi, vi) = (positions[i], velocities[i]);
-                let end = pi + vi * dt;
-                // Earliest contact: (hit, Some(triangle) for cloth, None for the body).
-                let mut best: Option<(Hit, usize, bool)> = None;
-                if let Some(body) = self.body.as_ref() {
-                    self.candidates.clear();
-                    body.broad
-                        .query(&pi, &end, p.thickness, &mut self.candidates);
-                    self.stats.candidates += self.candidates.len();
-                    for &t in &self.candidates {
-                        let tri = body.triangles[t as usize];
-                        let x = tri.map(|k| &body.start[k as usize]);
-                        let u = tri.map(|k| &body.vel[k as usize]);
-                        if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Front) {
-                            if p.one_sided
-                                && !normals.is_empty()
-                                && normals[i].dot(&hit.normal) <= 0.0
-                            {
-                                continue;
-                            }
-                            if best.is_none_or(|b| hit.time < b.0.time)
-                                && !met[..round].contains(&(t as usize, false))
-                            {
-                                best = Some((hit, t as usize, false));
-                            }
-                        }
-                    }
+            let mut candidates = std::mem::take(&mut self.candidates);
+            for i in 0..n {
+                if inverse_masses[i] == 0.0 {
+                    continue;
                 }
-                if p.self_collision
-                    && let Some(broad) = self.cloth_broad.as_ref()
-                {
-                    self.candidates.clear();
-                    broad.query(&pi, &end, p.thickness, &mut self.candidates);
-                    self.stats.candidates += self.candidates.len();
-                    for &t in &self.candidates {
-                        let tri = triangles[t as usize];
-                        if tri.contains(&(i as u32)) {
+                let view = NodeView {
+                    positions,
+                    velocities,
+                    inverse_masses,
+                    triangles,
+                    normals,
+                };
+                let r = self.node_pass(i, &view, dt, &mut candidates);
+                self.apply(i, &r, velocities, exit, planes);
+                for &(k, dv) in &r.cloth_dv {
+                    velocities[k] += dv;
+                }
+            }
+            self.candidates = candidates;
+            return;
+        }
+        let view = NodeView {
+            positions,
+            velocities,
+            inverse_masses,
+            triangles,
+            normals,
+        };
+        let this = &*self;
+        let results: Vec<(usize, NodeOutcome)> = (0..n)
+            .into_par_iter()
+            .with_min_len(256)
+            .map_init(Vec::new, |candidates, i| {
+                if inverse_masses[i] == 0.0 {
+                    return (i, NodeOutcome::default());
+                }
+                (i, this.node_pass(i, &view, dt, candidates))
+            })
+            .filter(|(_, r)| r.changed())
+            .collect();
+        for (i, r) in &results {
+            self.apply(*i, r, velocities, exit, planes);
+        }
+    }
+
+    /// Write one node's outcome and count it.
+    fn apply(
+        &mut self,
+        i: usize,
+        r: &NodeOutcome,
+        velocities: &mut [V3],
+        exit: &mut [V3],
+        planes: &mut [ContactPlane],
+    ) {
+        self.stats.candidates += r.candidates;
+        self.stats.body_hits += r.body_hits;
+        self.stats.self_hits += r.self_hits;
+        self.stats.recovered += usize::from(r.recovered);
+        if let Some(v) = r.velocity {
+            velocities[i] = v;
+        }
+        exit[i] += r.exit;
+        if let Some(plane) = r.plane
+            && !planes.is_empty()
+        {
+            planes[i] = plane;
+        }
+    }
+
+    /// One node's contacts in a pass: its earliest contact, then (with its corrected motion)
+    /// the earliest with a surface it has not met yet, up to `MAX_CONTACTS` — a node in a crease
+    /// between two parts meets both. Reads the node's own velocity (and, with self-collision,
+    /// the velocities of the cloth triangles it meets); returns what changes.
+    fn node_pass(
+        &self,
+        i: usize,
+        view: &NodeView<'_>,
+        dt: f64,
+        candidates: &mut Vec<u32>,
+    ) -> NodeOutcome {
+        let p = self.params;
+        let test = match p.narrow {
+            NarrowTest::Exact => point_triangle,
+            NarrowTest::Thesis => point_triangle_thesis,
+        };
+        let NodeView {
+            positions,
+            velocities,
+            inverse_masses,
+            triangles,
+            normals,
+        } = *view;
+        let mut out = NodeOutcome::default();
+        let pi = positions[i];
+        let mut vi = velocities[i];
+        let mut met: [(usize, bool); MAX_CONTACTS] = [(usize::MAX, false); MAX_CONTACTS];
+        for round in 0..MAX_CONTACTS {
+            let end = pi + vi * dt;
+            // Earliest contact: (hit, triangle, whether it is the cloth's).
+            let mut best: Option<(Hit, usize, bool)> = None;
+            if let Some(body) = self.body.as_ref() {
+                candidates.clear();
+                body.broad.query(&pi, &end, p.thickness, candidates);
+                out.candidates += candidates.len();
+                for &t in candidates.iter() {
+                    let tri = body.triangles[t as usize];
+                    let x = tri.map(|k| &body.start[k as usize]);
+                    let u = tri.map(|k| &body.vel[k as usize]);
+                    if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Front) {
+                        if p.one_sided && !normals.is_empty() && normals[i].dot(&hit.normal) <= 0.0
+                        {
                             continue;
                         }
-                        let x = tri.map(|k| &positions[k as usize]);
-                        let u = tri.map(|k| &velocities[k as usize]);
-                        if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Both)
-                            && best.is_none_or(|b| hit.time < b.0.time)
-                            && !met[..round].contains(&(t as usize, true))
+                        if best.is_none_or(|b| hit.time < b.0.time)
+                            && !met[..round].contains(&(t as usize, false))
                         {
-                            best = Some((hit, t as usize, true));
+                            best = Some((hit, t as usize, false));
                         }
                     }
                 }
-                let Some((hit, t, is_cloth)) = best else {
-                    if round == 0
-                        && p.recovery_depth > p.thickness
-                        && self.parts.is_none()
-                        && let Some(body) = self.body.as_ref()
-                        && let Some(dv) = recover(body, &pi, &vi, dt, p, &mut self.candidates)
-                    {
-                        velocities[i] += dv;
-                        self.stats.recovered += 1;
+            }
+            if p.self_collision
+                && let Some(broad) = self.cloth_broad.as_ref()
+            {
+                candidates.clear();
+                broad.query(&pi, &end, p.thickness, candidates);
+                out.candidates += candidates.len();
+                for &t in candidates.iter() {
+                    let tri = triangles[t as usize];
+                    if tri.contains(&(i as u32)) {
+                        continue;
                     }
-                    break;
-                };
-                met[round] = (t, is_cloth);
-                let (tri, inv_mu, u) = if is_cloth {
-                    let tri = triangles[t];
-                    (
-                        tri,
-                        tri.map(|k| inverse_masses[k as usize]),
-                        tri.map(|k| velocities[k as usize]),
-                    )
-                } else {
-                    let body = self.body.as_ref().expect("body hit");
-                    let tri = body.triangles[t];
-                    (tri, [0.0; 3], tri.map(|k| body.vel[k as usize]))
-                };
-                let Some(r) = respond(
-                    &vi,
-                    inverse_masses[i],
-                    [&u[0], &u[1], &u[2]],
-                    inv_mu,
-                    hit.weights,
-                    &hit.normal,
-                    hit.time,
-                    dt,
-                    p.material,
-                ) else {
-                    break;
-                };
-                velocities[i] = r.mean;
-                exit[i] += r.exit - r.mean;
-                if !is_cloth && p.plane_reach > 0.0 && !planes.is_empty() {
+                    let x = tri.map(|k| &positions[k as usize]);
+                    let u = tri.map(|k| &velocities[k as usize]);
+                    if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Both)
+                        && best.is_none_or(|b| hit.time < b.0.time)
+                        && !met[..round].contains(&(t as usize, true))
+                    {
+                        best = Some((hit, t as usize, true));
+                    }
+                }
+            }
+            let Some((hit, t, is_cloth)) = best else {
+                if round == 0
+                    && p.recovery_depth > p.thickness
+                    && self.parts.is_none()
+                    && let Some(body) = self.body.as_ref()
+                    && let Some(dv) = recover(body, &pi, &vi, dt, p, candidates)
+                {
+                    vi += dv;
+                    out.velocity = Some(vi);
+                    out.recovered = true;
+                }
+                break;
+            };
+            met[round] = (t, is_cloth);
+            let (tri, inv_mu, u) = if is_cloth {
+                let tri = triangles[t];
+                (
+                    tri,
+                    tri.map(|k| inverse_masses[k as usize]),
+                    tri.map(|k| velocities[k as usize]),
+                )
+            } else {
+                let body = self.body.as_ref().expect("body hit");
+                let tri = body.triangles[t];
+                (tri, [0.0; 3], tri.map(|k| body.vel[k as usize]))
+            };
+            let Some(r) = respond(
+                &vi,
+                inverse_masses[i],
+                [&u[0], &u[1], &u[2]],
+                inv_mu,
+                hit.weights,
+                &hit.normal,
+                hit.time,
+                dt,
+                p.material,
+            ) else {
+                break;
+            };
+            vi = r.mean;
+            out.velocity = Some(vi);
+            out.exit += r.exit - r.mean;
+            if is_cloth {
+                for k in 0..3 {
+                    out.cloth_dv.push((tri[k] as usize, r.vertex_dv[k]));
+                }
+                out.self_hits += 1;
+            } else {
+                if p.plane_reach > 0.0 {
                     let body = self.body.as_ref().expect("body hit");
                     let q: V3 = (0..3)
                         .map(|k| body.end[tri[k] as usize] * hit.weights[k])
                         .sum();
-                    planes[i] = ContactPlane {
+                    out.plane = Some(ContactPlane {
                         point: q + hit.normal * p.thickness,
                         normal: hit.normal,
                         velocity: (0..3)
                             .map(|k| body.vel[tri[k] as usize] * hit.weights[k])
                             .sum(),
                         friction: p.material.friction,
-                    };
+                    });
                 }
-                if is_cloth {
-                    for k in 0..3 {
-                        velocities[tri[k] as usize] += r.vertex_dv[k];
-                    }
-                    self.stats.self_hits += 1;
-                } else {
-                    self.stats.body_hits += 1;
-                }
+                out.body_hits += 1;
             }
         }
+        out
+    }
+}
+
+/// What one collision pass reads of the cloth.
+#[derive(Clone, Copy)]
+struct NodeView<'a> {
+    positions: &'a [V3],
+    velocities: &'a [V3],
+    inverse_masses: &'a [f64],
+    triangles: &'a [[u32; 3]],
+    normals: &'a [V3],
+}
+
+/// What one node's contacts in a pass changed.
+#[derive(Clone, Debug, Default)]
+struct NodeOutcome {
+    /// Its new velocity (the mean velocity over the step), if a contact or recovery changed it.
+    velocity: Option<V3>,
+    /// Added to its exit correction.
+    exit: V3,
+    /// The contact plane of its last body contact.
+    plane: Option<ContactPlane>,
+    /// Velocity changes of cloth triangle vertices it met (self-collision).
+    cloth_dv: Vec<(usize, V3)>,
+    candidates: usize,
+    body_hits: usize,
+    self_hits: usize,
+    recovered: bool,
+}
+
+impl NodeOutcome {
+    fn changed(&self) -> bool {
+        self.velocity.is_some() || self.candidates > 0
     }
 }
 

@@ -320,6 +320,12 @@ impl RigidParts {
         self.velocity(n) - before
     }
 
+    /// Whether no part moves in this step nor moved in the previous one (the staged transfer
+    /// then has nothing to add).
+    pub fn is_still(&self) -> bool {
+        self.start == self.end && self.prev_start == self.prev_end
+    }
+
     /// The largest displacement of any part's box corner over the step (bounds every surface
     /// point's displacement).
     pub fn max_displacement(&self) -> f64 {

@@ -375,8 +375,15 @@ pub struct MaterialTable {
 }
 
 impl MaterialTable {
-    /// Build the table for `edge_angles` (rad from the warp); returns it and, for each input
-    /// angle, the index of its entry.
+    /// Angles are binned to this resolution (0.1°, rad) before they are interpolated: a cut
+    /// garment's curved grid gives nearly every edge its own angle. Half a bin changes a
+    /// fixture's loading strain by at most 1 % of itself (4.9e-4 in strain) and its bending
+    /// rigidity by 0.06 % (test `half_an_angle_bin_changes_the_characteristics_little`).
+    pub const ANGLE_RESOLUTION: f64 = std::f64::consts::PI / 1800.0;
+
+    /// Build the table for `edge_angles` (rad from the warp, binned to
+    /// [`MaterialTable::ANGLE_RESOLUTION`]); returns it and, for each input angle, the index of
+    /// its entry.
     pub fn build(
         fabric: &Fabric,
         form: AnisotropyForm,
@@ -399,8 +406,9 @@ impl MaterialTable {
                     format!("edge angle {theta}"),
                 ));
             }
-            let canon = canonical_angle(theta);
-            let key = (canon * 1e9).round() as i64;
+            let key = (canonical_angle(theta) / Self::ANGLE_RESOLUTION).round() as i64;
+            let canon = canonical_angle(key as f64 * Self::ANGLE_RESOLUTION);
+            let key = (canon / Self::ANGLE_RESOLUTION).round() as i64;
             let idx = match index_of.get(&key) {
                 Some(&i) => i,
                 None => {

@@ -48,6 +48,12 @@ impl BodyContact {
         self.collider.parts()
     }
 
+    /// Each node's distance to the body at the start of the last step, or a lower bound
+    /// (see [`Collider::start_distances`]).
+    pub fn start_distances(&self) -> &[f64] {
+        self.collider.start_distances()
+    }
+
     /// The parts' motion over the coming step.
     ///
     /// # Errors

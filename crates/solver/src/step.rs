@@ -251,8 +251,10 @@ struct Scratch {
     lambda_c: Vec<f64>,
     /// Contact planes set by the hooks this step.
     planes: Vec<atelier_collide::ContactPlane>,
-    /// Nodes with a contact plane.
+    /// Nodes whose contact plane `project` applies (see `shape_iterations`).
     plane_nodes: Vec<u32>,
+    /// Nodes in a tie this step.
+    tied: Vec<bool>,
     /// Node pairs held within a distance this step.
     ties: Vec<Tie>,
     vel: Vec<V3>,
@@ -340,6 +342,25 @@ fn jacobian_transpose(cloth: &Cloth, cdir: &[V3], x: &[f64], i: usize) -> V3 {
 fn regularised(s: &atelier_fabric::Spindle, stick: f64, band: f64) -> atelier_fabric::Spindle {
     s.with_stick_slope(stick)
         .with_deadband(band * s.residual_moment() / s.rigidity())
+}
+
+/// A node's velocity such that it ends the step in front of `plane`: pushed out along the
+/// normal, and Coulomb friction taking up to ρ times that change off its velocity relative to
+/// the body, along the plane.
+fn plane_push(v: V3, x: &V3, plane: &atelier_collide::ContactPlane, dt: f64) -> V3 {
+    let d = (x + v * dt - plane.point).dot(&plane.normal);
+    if d >= 0.0 {
+        return v;
+    }
+    let dn = -d / dt;
+    let mut v = v + plane.normal * dn;
+    let rel = v - plane.velocity;
+    let tangential = rel - plane.normal * rel.dot(&plane.normal);
+    let t = tangential.norm();
+    if t > 0.0 {
+        v -= tangential * ((plane.friction * dn).min(t) / t);
+    }
+    v
 }
 
 fn first_non_finite_v(v: &[V3]) -> Option<usize> {
@@ -1406,17 +1427,31 @@ impl Solver {
         let mut cg_total = 0;
         self.s.vel_prev.copy_from_slice(&self.s.vel);
         self.s.lambda_c.fill(0.0);
+        // Contact planes: the Jacobi and Chebyshev node updates apply a node's plane as they
+        // compute it (in parallel); the planes of tied nodes, and every plane with the other
+        // methods, are applied after the ties in `project`.
+        let in_loop = matches!(
+            params.shape_method,
+            ShapeMethod::Jacobi | ShapeMethod::Chebyshev { .. }
+        );
         {
             let s = &mut self.s;
+            s.tied.clear();
+            s.tied.resize(s.planes.len(), false);
+            for t in &s.ties {
+                s.tied[t.a as usize] = true;
+                s.tied[t.b as usize] = true;
+            }
             s.plane_nodes.clear();
-            s.plane_nodes.extend(
-                (0..s.planes.len() as u32).filter(|&i| s.planes[i as usize].normal != V3::zeros()),
-            );
+            s.plane_nodes
+                .extend((0..s.planes.len() as u32).filter(|&i| {
+                    s.planes[i as usize].normal != V3::zeros() && (!in_loop || s.tied[i as usize])
+                }));
         }
         let stiffness = cloth.diagonal_stiffness();
         // The hard constraints first, so that an iteration that stops at once (the cloth's own
         // constraints already met) still leaves them met.
-        Self::project(&mut self.s, cloth, state, dt);
+        Self::project(&mut self.s, cloth, state, dt, true);
         for k in 0..params.shape_max_iterations {
             let s = &mut self.s;
             let (pos, vel, target) = (&state.positions, &s.vel, &s.target);
@@ -1483,6 +1518,7 @@ impl Solver {
             {
                 let (c, cdir, vel, prev, gamma) =
                     (&s.c, &s.cdir, &s.vel, &s.vel_prev, params.shape_step);
+                let (planes, tied, pos) = (&s.planes, &s.tied, &state.positions);
                 let node = |(i, (r, hat)): (usize, (&mut V3, &mut V3))| {
                     let inc = cloth.incidence(i);
                     let mut sum = V3::zeros();
@@ -1497,6 +1533,9 @@ impl Solver {
                     } else {
                         candidate
                     };
+                    if in_loop && planes[i].normal != V3::zeros() && !tied[i] {
+                        *hat = plane_push(*hat, &pos[i], &planes[i], dt);
+                    }
                 };
                 if s.r.len() >= PAR_MIN {
                     s.r.par_iter_mut()
@@ -1567,7 +1606,7 @@ impl Solver {
                     std::mem::swap(&mut s.vel, &mut s.vel_hat);
                 }
             }
-            Self::project(s, cloth, state, dt);
+            Self::project(s, cloth, state, dt, false);
         }
         (iterations, residual, cg_total)
     }
@@ -1575,8 +1614,9 @@ impl Solver {
     /// The hard constraints every shape iteration ends with: pins at their prescribed
     /// positions, ties (a pair farther apart than its length drawn together along its line,
     /// each node by its share of the inverse mass: momentum kept), and contact planes (no node
-    /// ends the step behind its plane), in that order.
-    fn project(s: &mut Scratch, cloth: &Cloth, state: &ClothState, dt: f64) {
+    /// ends the step behind its plane), in that order. `every_plane`: every node's plane, not
+    /// only those the node update leaves to this pass.
+    fn project(s: &mut Scratch, cloth: &Cloth, state: &ClothState, dt: f64, every_plane: bool) {
         let inv = cloth.inverse_masses();
         for pin in cloth.pins() {
             let i = pin.node as usize;
@@ -1599,20 +1639,16 @@ impl Solver {
             s.vel[a] += shift * inv[a];
             s.vel[b] -= shift * inv[b];
         }
-        for &i in &s.plane_nodes {
-            let (i, plane) = (i as usize, s.planes[i as usize]);
-            let d = (state.positions[i] + s.vel[i] * dt - plane.point).dot(&plane.normal);
-            if d < 0.0 {
-                // Push out along the normal; Coulomb friction takes up to ρ times that change
-                // off the velocity relative to the body, along the plane.
-                let dn = -d / dt;
-                s.vel[i] += plane.normal * dn;
-                let rel = s.vel[i] - plane.velocity;
-                let tangential = rel - plane.normal * rel.dot(&plane.normal);
-                let t = tangential.norm();
-                if t > 0.0 {
-                    s.vel[i] -= tangential * ((plane.friction * dn).min(t) / t);
+        if every_plane {
+            for i in 0..s.planes.len() {
+                if s.planes[i].normal != V3::zeros() {
+                    s.vel[i] = plane_push(s.vel[i], &state.positions[i], &s.planes[i], dt);
                 }
+            }
+        } else {
+            for &i in &s.plane_nodes {
+                let i = i as usize;
+                s.vel[i] = plane_push(s.vel[i], &state.positions[i], &s.planes[i], dt);
             }
         }
     }

@@ -27,7 +27,7 @@ pub use projection::ProjectionBroad;
 use crate::{Aabb, V3};
 
 /// A broad phase: the candidate triangles for a node's search segment.
-pub trait BroadPhase: Send {
+pub trait BroadPhase: Send + Sync {
     /// Set the triangles for this step: the surface moves from `start` to `end` (vertex
     /// positions, same length) during the step; `margin` (m) grows every triangle's swept box.
     /// Called every step; the BVH refits (never rebuilds while the triangle count stays), the

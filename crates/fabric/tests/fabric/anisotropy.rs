@@ -271,3 +271,43 @@ fn plate_theory_form_is_valid_at_every_angle() {
             .is_err()
     );
 }
+
+/// Binning the edge angles to `MaterialTable::ANGLE_RESOLUTION` (0.1°) moves an edge's angle by
+/// at most half a bin. Over every fixture, at every degree, half a bin changes the loading strain
+/// at 10 %, 50 % and 100 % of the maximum force by at most 1.03 % of itself (polyester faille at
+/// 5° and 10 % of the force, where the strain climbs steeply away from the stiff warp), at most
+/// 4.9e-4 in strain; and the bending rigidity by at most 0.06 %.
+#[test]
+fn half_an_angle_bin_changes_the_characteristics_little() {
+    let half = 0.5 * MaterialTable::ANGLE_RESOLUTION;
+    let (mut relative, mut absolute, mut rigidity): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    for name in FIXTURES {
+        let f = fixture(name);
+        for k in 0..180 {
+            let theta = (k as f64).to_radians();
+            let form = AnisotropyForm::PlateTheory;
+            let (a, b) = (
+                f.tensile_at(theta, form).expect("a"),
+                f.tensile_at(theta + half, form).expect("b"),
+            );
+            for frac in [0.1, 0.5, 1.0] {
+                let force = frac * a.max_force();
+                let (ea, eb) = (
+                    a.strain(Branch::Loading, force),
+                    b.strain(Branch::Loading, force),
+                );
+                relative = relative.max(((ea - eb) / ea).abs());
+                absolute = absolute.max((ea - eb).abs());
+            }
+            let (ba, bb) = (
+                f.bending_at(theta, form).expect("a").rigidity(),
+                f.bending_at(theta + half, form).expect("b").rigidity(),
+            );
+            rigidity = rigidity.max(((ba - bb) / ba).abs());
+        }
+    }
+    eprintln!(
+        "half a bin: strain {relative:.2e} relative, {absolute:.2e} absolute; rigidity {rigidity:.2e}"
+    );
+    assert!(relative < 0.011 && absolute < 6e-4 && rigidity < 1e-3);
+}
