@@ -209,7 +209,26 @@ impl Simulation {
         // The continuous test needs only the faces on the body's surface: a face buried in
         // another part (the parts overlap at the joints) can only be met from inside.
         let surface_triangles = exposed_triangles(&scene.body.mannequin, &rest, &parts);
-        contact.set_parts(parts);
+        // A wrap can reach into the body where it starts (a sleeve's cap wrapped about the
+        // shoulder joint lies partly inside the shoulder): every placed node inside the body or
+        // within the skin is moved out along the surface normal to the placement's clearance.
+        // One-sided dressing starts in front of the body and is left as laid out.
+        if !one_sided {
+            let mut at_start = parts;
+            at_start
+                .set_motion(&start_pose, &start_pose, settings.dt)
+                .map_err(|e| SceneError::Body(e.to_string()))?;
+            let out = g.place.clearance.max(2.0 * settings.skin);
+            for x in &mut state.positions {
+                if let Some(n) = at_start.nearest(x, settings.skin, false) {
+                    let (q, normal) = at_start.place(&n, false);
+                    *x = q + normal * out;
+                }
+            }
+            contact.set_parts(at_start);
+        } else {
+            contact.set_parts(parts);
+        }
         contact
             .set_body(
                 &posed.positions,

@@ -1,6 +1,6 @@
 //! The `atelier` command-line program.
 //!
-//! - `atelier` (no arguments): run the built-in default scenario — the dress (or skirt) sewn on
+//! - `atelier` (no arguments): run the built-in default scenario — the dress sewn on
 //!   the 9AR mannequin, then a short walk — into `./atelier-out`.
 //! - `atelier run SCENARIO.ron --out DIR [--threads N] [--frames K]`: run a scenario file.
 //! - `atelier validate FILE…`: check data files.
