@@ -6,6 +6,7 @@
 //! [`validate`], the checks behind `atelier validate FILE…`.
 
 pub mod assemble;
+pub mod chart;
 pub mod export;
 pub mod picture;
 pub mod pipeline;

@@ -28,7 +28,8 @@ use crate::export::{
 use crate::pipeline::run_garment;
 use crate::report::{ExpectationResult, Report};
 use crate::scenario::{
-    CantileverSpec, CatenarySpec, DrapeSpec, Scenario, ScenarioKind, StripDirection, Tester,
+    CantileverSpec, CatenarySpec, DrapeSpec, KesBendingSpec, KesTensileSpec, Scenario,
+    ScenarioKind, StripDirection, Tester,
 };
 use crate::simulation::Timings;
 
@@ -89,6 +90,8 @@ pub struct Simulated {
     pub warnings: Vec<String>,
     /// The failure that ended the run early.
     pub failure: Option<String>,
+    /// A chart drawn instead of the final state's views (the virtual KES tests: the loop).
+    pub chart: Option<crate::chart::Chart>,
 }
 
 /// Options of [`run`].
@@ -158,7 +161,10 @@ pub fn run(
     let style = match scenario.kind {
         ScenarioKind::Garment(_) => PictureStyle::Plain,
         ScenarioKind::Drape(_) => PictureStyle::WithTop,
-        ScenarioKind::Cantilever(_) | ScenarioKind::Catenary(_) => PictureStyle::Tilted,
+        ScenarioKind::Cantilever(_)
+        | ScenarioKind::Catenary(_)
+        | ScenarioKind::KesTensile(_)
+        | ScenarioKind::KesBending(_) => PictureStyle::Tilted,
     };
     let (written, warnings) = write_outputs(&sim, out, &options, style)?;
     report.outputs = written;
@@ -276,8 +282,11 @@ fn write_outputs(
         _ => draw(&|p| *p, w, h),
     };
     let path = out.join(outputs::PICTURE);
-    crate::picture::write_png(&path, &pixels, 2 * w, h, [1.0; 3])
-        .map_err(|source| RunError::Output { path, source })?;
+    match &sim.chart {
+        Some(chart) => crate::chart::write_chart(&path, chart, (2 * w as u32, h as u32)),
+        None => crate::picture::write_png(&path, &pixels, 2 * w, h, [1.0; 3]),
+    }
+    .map_err(|source| RunError::Output { path, source })?;
     written.push(outputs::PICTURE.into());
     if style == PictureStyle::WithTop {
         // Seen from above: screen x = x, screen y = −z (forward is down), depth y.
@@ -329,6 +338,8 @@ pub fn simulate(
         ScenarioKind::Drape(spec) => drape(spec, &fabric, progress)?,
         ScenarioKind::Cantilever(spec) => cantilever(spec, &fabric, progress)?,
         ScenarioKind::Catenary(spec) => catenary(spec, &fabric, progress)?,
+        ScenarioKind::KesTensile(spec) => kes_tensile(spec, &fabric)?,
+        ScenarioKind::KesBending(spec) => kes_bending(spec, &fabric)?,
     };
     sim.fabric = fabric.name.clone();
     trim_non_finite(&mut sim);
@@ -442,6 +453,7 @@ fn garment(
         metrics,
         warnings: run.warnings,
         failure: run.failure,
+        chart: None,
     })
 }
 
@@ -557,6 +569,7 @@ impl Stepper {
             metrics,
             warnings: Vec::new(),
             failure: self.failure,
+            chart: None,
         }
     }
 }
@@ -914,4 +927,197 @@ pub fn base_of(file: &Path) -> PathBuf {
         .map(Path::to_path_buf)
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or_else(|| PathBuf::from("."))
+}
+
+/// The two recorded frames of a virtual KES test: the specimen at rest and at the end.
+fn kes_frames(start: Vec<[f64; 3]>, end: &ClothState, time: f64) -> Animation {
+    let mut a = Animation::default();
+    a.push(0.0, start);
+    a.push(time, end.positions.iter().map(to_y_up).collect());
+    a
+}
+
+/// The virtual KES-FB1 tensile test: the specimen's loop 0 → F_m → 0 against the fabric's
+/// own loop along the same path (its tensile model, state by state).
+fn kes_tensile(spec: &KesTensileSpec, fabric: &Fabric) -> Result<Simulated, RunError> {
+    use atelier_fabric::{TensileState, units};
+    use atelier_solver::kes;
+    let setup = |e: String| RunError::Setup(format!("KES tensile test: {e}"));
+    let path = kes::cycle(units::force_from_kes(spec.max_force_gf_cm), spec.levels);
+    let form = AnisotropyForm::Thesis;
+    let clock = Instant::now();
+    let curve = kes::tensile_test(fabric, form, spec.direction, &path, 3)
+        .map_err(|e| setup(e.to_string()))?;
+    let wall = clock.elapsed().as_secs_f64();
+    let input_loop = match spec.direction {
+        StripDirection::Warp => &fabric.tensile.warp,
+        StripDirection::Weft => &fabric.tensile.weft,
+    };
+    let mut st = TensileState::VIRGIN;
+    let model: Vec<(f64, f64)> = path
+        .iter()
+        .map(|&f| (f, st.update(input_loop, f)))
+        .collect();
+    let (sim, input) = (curve.kes_values(), kes::values_of(&model));
+    let mut metrics = BTreeMap::new();
+    let errors = [
+        (sim.emt, input.emt),
+        (sim.lt, input.lt),
+        (sim.wt, input.wt),
+        (sim.rt, input.rt),
+    ]
+    .map(|(a, b)| (a / b - 1.0).abs());
+    for (k, v) in [
+        ("emt_percent", 100.0 * sim.emt),
+        ("input_emt_percent", 100.0 * input.emt),
+        ("lt", sim.lt),
+        ("input_lt", input.lt),
+        ("wt_gf_cm_cm2", units::energy_to_kes(sim.wt)),
+        ("input_wt_gf_cm_cm2", units::energy_to_kes(input.wt)),
+        ("rt_percent", 100.0 * sim.rt),
+        ("input_rt_percent", 100.0 * input.rt),
+        (
+            "largest_relative_error",
+            errors.iter().copied().fold(0.0, f64::max),
+        ),
+    ] {
+        metrics.insert(k.to_string(), Some(v));
+    }
+    let kes = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        pts.iter()
+            .map(|&(f, e)| (100.0 * e, units::force_to_kes(f)))
+            .collect()
+    };
+    let chart = crate::chart::Chart {
+        title: format!("KES-FB1 tensile, {} {:?}", fabric.name, spec.direction),
+        x_label: "strain (%)".into(),
+        y_label: "force per width (gf/cm)".into(),
+        series: vec![
+            crate::chart::Series {
+                name: "the fabric's loop".into(),
+                points: std::iter::once((0.0, 0.0)).chain(kes(&model)).collect(),
+            },
+            crate::chart::Series {
+                name: "simulated specimen".into(),
+                points: std::iter::once((0.0, 0.0))
+                    .chain(kes(&curve.points))
+                    .collect(),
+            },
+        ],
+    };
+    kes_simulated(
+        curve.cloth,
+        &curve.state,
+        curve.steps,
+        0.01,
+        wall,
+        metrics,
+        chart,
+    )
+}
+
+/// The virtual KES-FB2 bending test: B and 2HB of the specimen's loop against the fabric's.
+fn kes_bending(spec: &KesBendingSpec, fabric: &Fabric) -> Result<Simulated, RunError> {
+    use atelier_fabric::units;
+    use atelier_solver::kes;
+    let setup = |e: String| RunError::Setup(format!("KES bending test: {e}"));
+    let clock = Instant::now();
+    let curve = kes::bending_test(
+        fabric,
+        AnisotropyForm::Thesis,
+        spec.direction,
+        spec.steps_per_leg,
+    )
+    .map_err(|e| setup(e.to_string()))?;
+    let wall = clock.elapsed().as_secs_f64();
+    let spindle = match spec.direction {
+        StripDirection::Warp => &fabric.bending.warp,
+        StripDirection::Weft => &fabric.bending.weft,
+    };
+    let (b_in, hb_in) = (spindle.rigidity(), 2.0 * spindle.residual_moment());
+    let mut metrics = BTreeMap::new();
+    for (k, v) in [
+        ("b_gf_cm2_cm", units::rigidity_to_kes(curve.rigidity)),
+        ("input_b_gf_cm2_cm", units::rigidity_to_kes(b_in)),
+        ("two_hb_gf_cm_cm", units::moment_to_kes(curve.two_hb)),
+        ("input_two_hb_gf_cm_cm", units::moment_to_kes(hb_in)),
+        (
+            "largest_relative_error",
+            ((curve.rigidity / b_in - 1.0).abs()).max((curve.two_hb / hb_in - 1.0).abs()),
+        ),
+    ] {
+        metrics.insert(k.to_string(), Some(v));
+    }
+    // The fabric's own loop along the same curvature path, through its hysteresis state.
+    let mut st = atelier_fabric::BendingState::VIRGIN;
+    let model: Vec<(f64, f64)> = curve
+        .passes
+        .iter()
+        .flatten()
+        .map(|&(eta, _)| (eta, st.update(spindle, eta)))
+        .collect();
+    let kes_pts = |pts: &mut dyn Iterator<Item = (f64, f64)>| -> Vec<(f64, f64)> {
+        pts.map(|(eta, m)| (units::curvature_to_kes(eta), units::moment_to_kes(m)))
+            .collect()
+    };
+    let chart = crate::chart::Chart {
+        title: format!("KES-FB2 bending, {} {:?}", fabric.name, spec.direction),
+        x_label: "curvature (1/cm)".into(),
+        y_label: "moment per width (gf·cm/cm)".into(),
+        series: vec![
+            crate::chart::Series {
+                name: "the fabric's spindle".into(),
+                points: kes_pts(&mut model.iter().copied()),
+            },
+            crate::chart::Series {
+                name: "simulated specimen".into(),
+                points: kes_pts(&mut curve.passes.iter().flatten().copied()),
+            },
+        ],
+    };
+    kes_simulated(
+        curve.cloth,
+        &curve.state,
+        curve.steps,
+        1e-3,
+        wall,
+        metrics,
+        chart,
+    )
+}
+
+fn kes_simulated(
+    cloth: Cloth,
+    state: &ClothState,
+    steps: usize,
+    dt: f64,
+    wall: f64,
+    mut metrics: BTreeMap<String, Option<f64>>,
+    chart: crate::chart::Chart,
+) -> Result<Simulated, RunError> {
+    let rest: Vec<[f64; 3]> = cloth
+        .topology()
+        .rest_positions()
+        .iter()
+        .map(|&[x, y]| to_y_up(&Vector3::new(x, y, 0.0)))
+        .collect();
+    metrics.insert(
+        "kinetic_energy_j".into(),
+        Some(state.kinetic_energy(&cloth)),
+    );
+    Ok(Simulated {
+        fabric: String::new(),
+        cloth_triangles: cloth.topology().triangles().to_vec(),
+        cloth: kes_frames(rest, state, state.time),
+        solid: None,
+        steps,
+        dt,
+        simulated: state.time,
+        wall_seconds: wall,
+        timings: Timings::default(),
+        metrics,
+        warnings: Vec::new(),
+        failure: None,
+        chart: Some(chart),
+    })
 }

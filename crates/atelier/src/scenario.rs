@@ -53,6 +53,12 @@ pub enum ScenarioKind {
     Cantilever(CantileverSpec),
     /// A strip hung from both ends, bending off, against the inextensible catenary.
     Catenary(CatenarySpec),
+    /// The KES-FB1 tensile test on a simulated specimen: its loop's EMT, LT, WT, RT against
+    /// the fabric's.
+    KesTensile(KesTensileSpec),
+    /// The KES-FB2 bending test on a simulated specimen: its loop's B and 2HB against the
+    /// fabric's.
+    KesBending(KesBendingSpec),
 }
 
 impl ScenarioKind {
@@ -63,6 +69,8 @@ impl ScenarioKind {
             ScenarioKind::Drape(_) => "Drape",
             ScenarioKind::Cantilever(_) => "Cantilever",
             ScenarioKind::Catenary(_) => "Catenary",
+            ScenarioKind::KesTensile(_) => "KesTensile",
+            ScenarioKind::KesBending(_) => "KesBending",
         }
     }
 
@@ -73,6 +81,8 @@ impl ScenarioKind {
             ScenarioKind::Drape(s) => &s.fabric,
             ScenarioKind::Cantilever(s) => &s.fabric,
             ScenarioKind::Catenary(s) => &s.fabric,
+            ScenarioKind::KesTensile(s) => &s.fabric,
+            ScenarioKind::KesBending(s) => &s.fabric,
         }
     }
 
@@ -137,6 +147,34 @@ impl ScenarioKind {
                 "sag_m",
                 "max_speed_m_s",
                 "max_strain_error",
+                "kinetic_energy_j",
+                "frames",
+            ],
+            ScenarioKind::KesTensile(_) => &[
+                "nodes",
+                "cloth_triangles",
+                "simulated_s",
+                "emt_percent",
+                "input_emt_percent",
+                "lt",
+                "input_lt",
+                "wt_gf_cm_cm2",
+                "input_wt_gf_cm_cm2",
+                "rt_percent",
+                "input_rt_percent",
+                "largest_relative_error",
+                "kinetic_energy_j",
+                "frames",
+            ],
+            ScenarioKind::KesBending(_) => &[
+                "nodes",
+                "cloth_triangles",
+                "simulated_s",
+                "b_gf_cm2_cm",
+                "input_b_gf_cm2_cm",
+                "two_hb_gf_cm_cm",
+                "input_two_hb_gf_cm_cm",
+                "largest_relative_error",
                 "kinetic_energy_j",
                 "frames",
             ],
@@ -218,14 +256,38 @@ pub struct DrapeSpec {
     pub step: StepParams,
 }
 
-/// The grain direction along a strip.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum StripDirection {
-    /// The strip runs along the warp.
-    #[default]
-    Warp,
-    /// The strip runs along the weft.
-    Weft,
+/// The grain direction along a strip: `Warp` (default) or `Weft`.
+pub use atelier_solver::kes::Direction as StripDirection;
+
+/// The virtual KES-FB1 tensile test (`atelier_solver::kes::tensile_test`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KesTensileSpec {
+    /// Fabric file (RON).
+    pub fabric: PathBuf,
+    /// Direction of the specimen. Default `Warp`.
+    #[serde(default)]
+    pub direction: StripDirection,
+    /// Largest force, gf/cm. Default 500 (the KES-FB1 standard F_m).
+    #[serde(default = "default_kes_force")]
+    pub max_force_gf_cm: f64,
+    /// Force levels each way (0 → F_m and back). Default 100.
+    #[serde(default = "default_kes_levels")]
+    pub levels: usize,
+}
+
+/// The virtual KES-FB2 bending test (`atelier_solver::kes::bending_test`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KesBendingSpec {
+    /// Fabric file (RON).
+    pub fabric: PathBuf,
+    /// Direction of the specimen. Default `Warp`.
+    #[serde(default)]
+    pub direction: StripDirection,
+    /// Steps of 1 ms per leg of the cycle 0 → +2.5 → −2.5 → 0 cm⁻¹. Default 500.
+    #[serde(default = "default_kes_steps")]
+    pub steps_per_leg: usize,
 }
 
 /// The Peirce cantilever.
@@ -311,6 +373,15 @@ fn default_drape_form() -> AnisotropyForm {
 }
 fn default_frame_interval() -> f64 {
     0.04
+}
+fn default_kes_force() -> f64 {
+    500.0
+}
+fn default_kes_levels() -> usize {
+    100
+}
+fn default_kes_steps() -> usize {
+    500
 }
 fn default_segments() -> usize {
     40
@@ -445,6 +516,25 @@ impl Scenario {
                 positive("kind.damping", c.damping)?;
                 positive("kind.max_time", c.max_time)?;
                 positive("kind.frame_interval", c.frame_interval)?;
+            }
+            ScenarioKind::KesTensile(k) => {
+                positive("kind.max_force_gf_cm", k.max_force_gf_cm)?;
+                if !(2..=10_000).contains(&k.levels) {
+                    return bad(
+                        "kind.levels",
+                        ErrorKind::OutOfRange,
+                        format!("{} levels: use 2 to 10000", k.levels),
+                    );
+                }
+            }
+            ScenarioKind::KesBending(k) => {
+                if !(20..=100_000).contains(&k.steps_per_leg) {
+                    return bad(
+                        "kind.steps_per_leg",
+                        ErrorKind::OutOfRange,
+                        format!("{} steps: use 20 to 100000", k.steps_per_leg),
+                    );
+                }
             }
             ScenarioKind::Catenary(c) => {
                 positive("kind.length", c.length)?;

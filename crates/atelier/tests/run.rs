@@ -254,3 +254,36 @@ fn every_fixture_scenario_reads_and_names_existing_files() {
     }
     assert!(count >= 20, "{count} scenarios");
 }
+
+/// The virtual KES scenarios: each specimen's loop gives back the fabric's values (EMT, LT, WT,
+/// RT within 1 %; B and 2HB within 1 %), and its chart is written as the picture.
+#[test]
+fn virtual_kes_scenarios_give_back_the_fabrics_values() {
+    for (name, tolerance) in [
+        ("kes_tensile_denim_weft", 0.01),
+        ("kes_bending_denim_weft", 0.01),
+        ("kes_bending_cotton_broad", 0.01),
+    ] {
+        let file = root().join(format!("fixtures/scenarios/{name}.ron"));
+        let scenario = Scenario::load(&file).expect("scenario");
+        let out = temp_dir(name);
+        let report = run(
+            &scenario,
+            Some(&file),
+            &atelier::run::base_of(&file),
+            &out,
+            &RunOptions::default(),
+            &mut |_| {},
+        )
+        .expect("runs");
+        assert!(report.passed(), "{}", report.summary_line());
+        let err = report.metrics["largest_relative_error"].expect("measured");
+        assert!(err < tolerance, "{name}: {err}");
+        for k in scenario.kind.metric_names() {
+            assert!(report.metrics.contains_key(*k), "{name}: {k}");
+        }
+        let png = std::fs::read(out.join("final.png")).expect("chart written");
+        assert!(png.len() > 10_000 && png.starts_with(b"\x89PNG"));
+        std::fs::remove_dir_all(&out).ok();
+    }
+}

@@ -13,6 +13,7 @@
 pub mod baselines;
 pub mod cloth;
 pub mod contact;
+pub mod kes;
 pub mod leg;
 pub mod metrics;
 pub mod params;

@@ -1,0 +1,116 @@
+//! Line charts for the reports of virtual tests: a KES loop, simulated against the fabric's own,
+//! drawn with plotters and the bundled DejaVu Sans (no system fonts needed), written
+//! atomically.
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use plotters::prelude::*;
+
+/// One curve of a chart.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Its name in the legend.
+    pub name: String,
+    /// Its points (x, y), in order.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A chart: title, axis labels and curves.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chart {
+    /// Title.
+    pub title: String,
+    /// X axis label, with its unit.
+    pub x_label: String,
+    /// Y axis label, with its unit.
+    pub y_label: String,
+    /// The curves (the first drawn as a thick line, the others thin and on top).
+    pub series: Vec<Series>,
+}
+
+/// Register the bundled font once; false when it cannot be loaded.
+fn font() -> bool {
+    static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
+    static OK: OnceLock<bool> = OnceLock::new();
+    *OK.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()
+    })
+}
+
+const COLOURS: [RGBColor; 3] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+];
+
+/// Draw `chart` into a PNG of `size` pixels at `path` (a temporary file beside it, renamed when
+/// complete).
+pub fn write_chart(path: &Path, chart: &Chart, size: (u32, u32)) -> std::io::Result<()> {
+    if !font() {
+        return Err(std::io::Error::other(
+            "the bundled font could not be loaded",
+        ));
+    }
+    let tmp = atelier_fabric::files::temporary_sibling(path);
+    let drawn = draw(&tmp, chart, size);
+    match drawn {
+        Ok(()) => std::fs::rename(&tmp, path),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(std::io::Error::other(e))
+        }
+    }
+}
+
+fn draw(
+    file: &Path,
+    chart: &Chart,
+    size: (u32, u32),
+) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    let root = BitMapBackend::new(file, size).into_drawing_area();
+    root.fill(&WHITE)?;
+    let all = chart.series.iter().flat_map(|s| s.points.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in all {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    if !(x1 > x0 && y1 > y0) {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let (px, py) = (0.05 * (x1 - x0), 0.05 * (y1 - y0));
+    let mut c = ChartBuilder::on(&root)
+        .caption(&chart.title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d((x0 - px)..(x1 + px), (y0 - py)..(y1 + py))?;
+    c.configure_mesh()
+        .x_desc(chart.x_label.as_str())
+        .y_desc(chart.y_label.as_str())
+        .label_style(("sans-serif", 14))
+        .draw()?;
+    for (k, s) in chart.series.iter().enumerate() {
+        let colour = COLOURS[k % COLOURS.len()];
+        let width = if k == 0 { 5 } else { 2 };
+        c.draw_series(LineSeries::new(
+            s.points.iter().copied(),
+            colour.stroke_width(width),
+        ))?
+        .label(s.name.as_str())
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(3)));
+    }
+    c.configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
