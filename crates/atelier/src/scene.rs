@@ -14,7 +14,7 @@ use atelier_body::motion::Motion;
 use atelier_fabric::{AnisotropyForm, ErrorKind, Fabric, InvalidValue, STANDARD_GRAVITY};
 use atelier_grid::ImproveParams;
 use atelier_grid::pattern::load_garment;
-use atelier_solver::{ConstraintKind, StepParams};
+use atelier_solver::StepParams;
 use serde::{Deserialize, Serialize};
 
 use crate::place::{PlaceParams, Placement};
@@ -84,7 +84,9 @@ pub struct Settings {
     /// hold the skin, the flat triangles between them do not: with a skin of 1 mm the body's
     /// creases showed through 2 cm cells).
     pub skin: f64,
-    /// Cloth against itself. Default false (the thesis left it out for speed).
+    /// Cloth against itself, once the garment is on (not while its seams are drawn together:
+    /// a seam's two sides pass the cloth between them), the two sides of every seam excepted.
+    /// Default false (the thesis left it out for speed).
     pub self_collision: bool,
     /// The staged model of moving bodies (thesis §5.4): the body's motion transferred to the
     /// cloth near it before the shape constraints. Default true; false: the physical model
@@ -104,7 +106,8 @@ pub struct Settings {
     pub frame_interval: f64,
     /// Overrides of the solver's step parameters: damping (air drag), tolerances and iteration
     /// caps, tolerance policy, methods (Δt and gravity are set by the scene). Default: the
-    /// solver's defaults with compliant shear diagonals.
+    /// solver's defaults (diagonals held at the targets of the fabric's shear characteristic,
+    /// as in the thesis).
     pub step: StepParams,
 }
 
@@ -124,10 +127,7 @@ impl Default for Settings {
             settle: 1.0,
             motion_time: 0.0,
             frame_interval: 0.04,
-            step: StepParams {
-                diagonal_constraint: ConstraintKind::Compliant,
-                ..StepParams::default()
-            },
+            step: StepParams::default(),
         }
     }
 }

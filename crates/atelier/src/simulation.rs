@@ -189,7 +189,9 @@ impl Simulation {
                 // gravity starts.
                 friction: if one_sided { 0.0 } else { settings.friction },
             },
-            self_collision: settings.self_collision,
+            // Self-collision starts once the garment is on (`start_settling`): while seams are
+            // drawn together, a seam's two sides must pass the cloth between them.
+            self_collision: false,
             thickness: settings.skin,
             staged: settings.staged,
             one_sided,
@@ -197,6 +199,13 @@ impl Simulation {
         };
         let mut contact = BodyContact::new(&g.cloth.cloth, contact_params)
             .map_err(|e| SceneError::Body(e.to_string()))?;
+        if settings.self_collision {
+            // The two sides of a seam are one point of the garment: they never collide.
+            contact.set_cloth_groups(seam_groups(
+                g.cloth.cloth.topology().node_count(),
+                &g.cloth.pairs,
+            ));
+        }
         let part_meshes: Vec<(&[V3], &[[u32; 3]])> = scene
             .body
             .mannequin
@@ -211,14 +220,15 @@ impl Simulation {
         let surface_triangles = exposed_triangles(&scene.body.mannequin, &rest, &parts);
         // A wrap can reach into the body where it starts (a sleeve's cap wrapped about the
         // shoulder joint lies partly inside the shoulder): every placed node inside the body or
-        // within the skin is moved out along the surface normal to the placement's clearance.
-        // One-sided dressing starts in front of the body and is left as laid out.
+        // within the skin is moved out along the surface normal to twice the skin (no farther:
+        // its neighbours stay where they were placed). One-sided dressing starts in front of
+        // the body and is left as laid out.
         if !one_sided {
             let mut at_start = parts;
             at_start
                 .set_motion(&start_pose, &start_pose, settings.dt)
                 .map_err(|e| SceneError::Body(e.to_string()))?;
-            let out = g.place.clearance.max(2.0 * settings.skin);
+            let out = 2.0 * settings.skin;
             for x in &mut state.positions {
                 if let Some(n) = at_start.nearest(x, settings.skin, false) {
                     let (q, normal) = at_start.place(&n, false);
@@ -409,6 +419,9 @@ impl Simulation {
     fn start_settling(&mut self) {
         self.phase = Phase::Settling;
         self.params.gravity = self.scene.settings.gravity;
+        if self.scene.settings.self_collision {
+            self.contact.set_self_collision(true);
+        }
     }
 
     /// One step of Δt through every stage; `Ok(None)` once the schedule is over (nothing is
@@ -561,6 +574,24 @@ fn penetration(
             }
         })
         .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
+}
+
+/// For every node, the smallest node it is joined to through seam pairs (itself when none).
+fn seam_groups(n: usize, pairs: &[(u32, u32)]) -> Vec<u32> {
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            parent[x as usize] = parent[parent[x as usize] as usize];
+            x = parent[x as usize];
+        }
+        x
+    }
+    for &(a, b) in pairs {
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        parent[hi as usize] = lo;
+    }
+    (0..n as u32).map(|i| root(&mut parent, i)).collect()
 }
 
 /// The rigid motion of every part (rest → world) in a pose, in the mannequin's part order.

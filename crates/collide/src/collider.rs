@@ -225,6 +225,10 @@ pub struct Collider {
     parts: Option<RigidParts>,
     /// Per node: velocity change and contact plane found by the parts transfer.
     part_results: Vec<Option<(V3, Option<ContactPlane>)>>,
+    /// Per cloth node, the group of nodes that are one point of the garment (a seam's two
+    /// sides): self-collision ignores a triangle with a node of the same group. Empty: every
+    /// node is its own group.
+    groups: Vec<u32>,
     /// Per node: its distance to the body at the start of the step as the parts transfer found
     /// it (negative inside), or a lower bound (the search reach) when it is farther.
     start_distance: Vec<f64>,
@@ -243,6 +247,7 @@ impl Collider {
             body: None,
             parts: None,
             part_results: Vec::new(),
+            groups: Vec::new(),
             start_distance: Vec::new(),
             cloth_broad: None,
             candidates: Vec::new(),
@@ -370,6 +375,19 @@ impl Collider {
             Some(parts) => Ok(parts.set_motion(start, end, dt)?),
             None => Err(ContactError::Parts(PartsError::Empty)),
         }
+    }
+
+    /// Nodes that are one point of the garment (`groups[i]` the same for the nodes of a seam's
+    /// two sides): self-collision lets them and the triangles around them pass, as it does a
+    /// node and its own triangles. Empty: none.
+    pub fn set_cloth_groups(&mut self, groups: Vec<u32>) {
+        self.groups = groups;
+    }
+
+    /// Turn self-collision on or off (the cloth's broad phase is built at the next pass that
+    /// needs it).
+    pub fn set_self_collision(&mut self, on: bool) {
+        self.params.self_collision = on;
     }
 
     /// Change the static friction ρ against the body (and the cloth).
@@ -713,7 +731,12 @@ impl Collider {
                 out.candidates += candidates.len();
                 for &t in candidates.iter() {
                     let tri = triangles[t as usize];
-                    if tri.contains(&(i as u32)) {
+                    if tri.contains(&(i as u32))
+                        || (!self.groups.is_empty()
+                            && tri
+                                .iter()
+                                .any(|&k| self.groups[k as usize] == self.groups[i]))
+                    {
                         continue;
                     }
                     let x = tri.map(|k| &positions[k as usize]);

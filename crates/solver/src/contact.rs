@@ -67,6 +67,16 @@ impl BodyContact {
         self.collider.set_part_motion(start, end, dt)
     }
 
+    /// Nodes that are one point of the garment (see [`Collider::set_cloth_groups`]).
+    pub fn set_cloth_groups(&mut self, groups: Vec<u32>) {
+        self.collider.set_cloth_groups(groups);
+    }
+
+    /// Turn self-collision on or off.
+    pub fn set_self_collision(&mut self, on: bool) {
+        self.collider.set_self_collision(on);
+    }
+
     /// Change the static friction ρ.
     pub fn set_friction(&mut self, friction: f64) {
         self.collider.set_friction(friction);

@@ -171,7 +171,7 @@ fn virtual_kes_bending_test_recovers_b_and_2hb() {
 /// under the instrument's 10 gf/cm pretension. The interior columns lean by γ = τ / G, G the
 /// fabric's KES shear stiffness; with rigid diagonals they do not lean at all.
 #[test]
-#[ignore = "issue 7, not met yet: the strip leans 2.76° (Chebyshev) or 4.52° (Jacobi) at τ = 1 gf/cm against τ/G = 0.667°, and is still moving after 3 s (kinetic energy 7e-4 J, shape residual 1e-7 m after 800 iterations): the compliant iteration has not reached its fixed point, so the lean depends on the iteration"]
+#[ignore = "the compliant diagonals (an option, not a default) are not right yet: the strip leans 2.76° (Chebyshev) or 4.52° (Jacobi) at τ = 1 gf/cm against τ/G = 0.667°, and is still moving after 3 s (kinetic energy 7e-4 J, shape residual 1e-7 m after 800 iterations): the compliant iteration has not reached its fixed point, so the lean depends on the iteration"]
 fn compliant_diagonals_shear_by_the_kes_stiffness() {
     use atelier_solver::ConstraintKind;
     let f = fabric("cotton_broad");
