@@ -254,12 +254,12 @@ fn key_metrics(r: &Report) -> String {
     };
     match r.scenario.kind.as_str() {
         "Garment" => format!(
-            "sewn {}/{} pairs{}, deepest inside body {}, max strain error {}",
+            "sewn {}/{} pairs{}, deepest inside body {}, final strain error {}",
             f(m("pairs_sewn"), 0, ""),
             f(m("pairs"), 0, ""),
             m("sewn_at_s").map_or(String::new(), |t| format!(" at {t:.2} s")),
             f(m("max_penetration_m").map(|v| v * 1e3), 1, " mm"),
-            f(m("max_strain_error"), 3, ""),
+            f(m("final_strain_error"), 3, ""),
         ),
         "Drape" => format!(
             "DC {}, {} nodes, {}",
@@ -279,6 +279,22 @@ fn key_metrics(r: &Report) -> String {
         "Catenary" => format!(
             "max deviation {} of the span",
             f(m("max_deviation_percent_span"), 3, " %")
+        ),
+        "KesTensile" => format!(
+            "EMT {} ({}), LT {} ({}), RT {} ({})",
+            f(m("emt_percent"), 3, " %"),
+            f(m("input_emt_percent"), 3, " %"),
+            f(m("lt"), 4, ""),
+            f(m("input_lt"), 4, ""),
+            f(m("rt_percent"), 2, " %"),
+            f(m("input_rt_percent"), 2, " %"),
+        ),
+        "KesBending" => format!(
+            "B {} ({}) gf·cm²/cm, 2HB {} ({}) gf·cm/cm",
+            f(m("b_gf_cm2_cm"), 4, ""),
+            f(m("input_b_gf_cm2_cm"), 4, ""),
+            f(m("two_hb_gf_cm_cm"), 4, ""),
+            f(m("input_two_hb_gf_cm_cm"), 4, ""),
         ),
         _ => String::new(),
     }

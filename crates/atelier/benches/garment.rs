@@ -1,0 +1,202 @@
+//! Benchmarks of the garment pipeline (issue 7, "Speed"): the eight-panel dress of
+//! `fixtures/scenarios/dress_sewn.ron` (2 558 nodes, cotton broad) on the 9AR mannequin
+//! (2 832 triangles, of which the continuous test keeps the exposed ones).
+//!
+//! - `garment/dress_sewn`: the whole scenario — load, grid, place, sew, settle 1 s — as
+//!   [`run_garment`] runs it (the issue's goal: ≤ 2 s on 2 cores).
+//! - `garment/setup`: loading, gridding and placing (`Scene::load` + `Simulation::new`).
+//! - `garment/step_standing`: one step of the sewn dress standing under gravity.
+//! - `garment/step_walking` and `garment/step_walking_self_collision`: one step of the dress
+//!   during the walk (the first 5 s of `walk.ron`, cycled), without and with self-collision.
+//!
+//! After the benches, [`stage_table`] steps each scene on and writes the median of every stage
+//! per step to stderr and to `$CARGO_TARGET_DIR/atelier-bench/garment_stages.md` (default
+//! `target/`), the table `docs/performance.md` quotes.
+//!
+//! `cargo test --benches` runs each bench once (criterion's test mode) and one step per stage
+//! median, so CI checks that the benches still run (a few seconds) without timing anything.
+
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use atelier::pipeline::run_garment;
+use atelier::scenario::{Scenario, ScenarioKind};
+use atelier::simulation::Timings;
+use atelier::{GarmentSpec, Phase, Scene, Simulation};
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn scenarios() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios")
+}
+
+fn spec(name: &str) -> GarmentSpec {
+    let s = Scenario::load(&scenarios().join(format!("{name}.ron"))).expect("scenario");
+    let ScenarioKind::Garment(spec) = s.kind else {
+        panic!("{name} is a garment scenario")
+    };
+    spec
+}
+
+/// Whether criterion is measuring (`cargo bench`), not in its test mode (`cargo test --benches`,
+/// or `cargo bench -- --test`).
+fn measuring() -> bool {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter().any(|a| a == "--bench") && !args.iter().any(|a| a == "--test" || a == "--list")
+}
+
+/// A simulation of `spec` stepped until `phase` has begun (and `extra` s into it).
+fn advanced(spec: &GarmentSpec, phase: Phase, extra: f64) -> Simulation {
+    let scene = Scene::load(spec, &scenarios()).expect("scene");
+    let mut sim = Simulation::new(scene).expect("simulation");
+    let mut since = None;
+    loop {
+        let o = sim.step().expect("step").expect("the schedule goes on");
+        if o.phase == phase {
+            let start = *since.get_or_insert(sim.time());
+            if sim.time() - start >= extra - 1e-9 {
+                return sim;
+            }
+        }
+    }
+}
+
+/// The dress standing, sewn and settled for 0.2 s, its settling long enough never to end.
+fn standing() -> Simulation {
+    let mut s = spec("dress_sewn");
+    s.settings.settle = 1e6;
+    advanced(&s, Phase::Settling, 0.2)
+}
+
+/// The dress walking, 0.1 s into the walk (the walk's first 0.3 s are still), its walk long
+/// enough never to end (`walked` restarts it before the fixture's last keyframe).
+fn walking(self_collision: bool) -> Simulation {
+    let mut s = spec("dress_walk");
+    s.settings.settle = 0.2;
+    s.settings.motion_time = 1e6;
+    s.settings.self_collision = self_collision;
+    advanced(&s, Phase::Motion, 0.4)
+}
+
+/// Step a walking simulation `n` times (timed), restarting it (untimed) before the walk
+/// fixture's end at 6 s of motion.
+fn walked(sim: &mut Simulation, n: u64, self_collision: bool) -> Duration {
+    let mut timed = Duration::ZERO;
+    for _ in 0..n {
+        if sim.time() > 0.2 + 0.2 + 5.0 {
+            *sim = walking(self_collision);
+        }
+        let t = Instant::now();
+        black_box(sim.step().expect("step"));
+        timed += t.elapsed();
+    }
+    timed
+}
+
+fn garment(c: &mut Criterion) {
+    let mut g = c.benchmark_group("garment");
+    g.sample_size(10);
+    g.measurement_time(Duration::from_secs(20));
+    let sewn = spec("dress_sewn");
+    g.bench_function("dress_sewn", |b| {
+        b.iter(|| {
+            let run = run_garment(&sewn, &scenarios(), &mut |_| {}).expect("runs");
+            assert_eq!(run.pairs.0, run.pairs.1);
+            black_box(run.steps)
+        })
+    });
+    g.bench_function("setup", |b| {
+        b.iter(|| {
+            let scene = Scene::load(&sewn, &scenarios()).expect("scene");
+            black_box(Simulation::new(scene).expect("simulation"))
+        })
+    });
+    g.finish();
+    let mut g = c.benchmark_group("garment");
+    g.sample_size(30);
+    let mut sim = standing();
+    g.bench_function("step_standing", |b| {
+        b.iter(|| black_box(sim.step().expect("step")))
+    });
+    for self_collision in [false, true] {
+        let mut sim = walking(self_collision);
+        let name = if self_collision {
+            "step_walking_self_collision"
+        } else {
+            "step_walking"
+        };
+        g.bench_function(name, |b| {
+            b.iter_custom(|n| walked(&mut sim, n, self_collision))
+        });
+    }
+    g.finish();
+    stage_table();
+}
+
+/// Median of each stage per step over `steps` steps of each scene.
+fn stage_table() {
+    let steps = if measuring() { 200 } else { 1 };
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "| scene | nodes | steps | body | bending | internal | velocity | transfer | shape | collision | update | diagnostics | total (ms per step, medians) |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let scenes: [(&str, Box<dyn Fn() -> Simulation>); 3] = [
+        ("dress standing", Box::new(standing)),
+        ("dress walking", Box::new(|| walking(false))),
+        ("dress walking, self-collision", Box::new(|| walking(true))),
+    ];
+    for (name, make) in scenes {
+        let mut sim = make();
+        let nodes = sim.state().positions.len();
+        let mut samples: Vec<Timings> = Vec::with_capacity(steps);
+        for _ in 0..steps {
+            let o = sim.step().expect("step").expect("goes on");
+            samples.push(o.timings);
+        }
+        let median = |f: &dyn Fn(&Timings) -> Duration| {
+            let mut v: Vec<f64> = samples.iter().map(|t| f(t).as_secs_f64() * 1e3).collect();
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        let cols: [&dyn Fn(&Timings) -> Duration; 10] = [
+            &|t| t.body,
+            &|t| t.solver.bending,
+            &|t| t.solver.internal,
+            &|t| t.solver.velocity,
+            &|t| t.solver.transfer,
+            &|t| t.solver.shape,
+            &|t| t.solver.collision,
+            &|t| t.solver.update,
+            &|t| t.diagnostics,
+            &|t| t.total(),
+        ];
+        let cells: Vec<String> = cols.iter().map(|f| format!("{:.2}", median(*f))).collect();
+        let _ = writeln!(
+            out,
+            "| {name} | {nodes} | {steps} | {} |",
+            cells.join(" | ")
+        );
+    }
+    eprintln!("\n{out}");
+    let dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(
+            || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"),
+            PathBuf::from,
+        )
+        .join("atelier-bench");
+    if std::fs::create_dir_all(&dir).is_ok() {
+        let _ = std::fs::write(dir.join("garment_stages.md"), out);
+    }
+}
+
+criterion_group! {
+    name = benches;
+    // No HTML plots: with the workspace's plotters (ab_glyph, no system fonts) criterion's own
+    // plots find no font; the tables above are the output.
+    config = Criterion::default().without_plots();
+    targets = garment
+}
+criterion_main!(benches);
