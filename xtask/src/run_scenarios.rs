@@ -124,6 +124,8 @@ pub fn run_all(
         .map(|(_, f)| f)
         .collect();
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    // The commit the results come from, read before this run writes into docs/.
+    let revision = commit(root);
     let clock = Instant::now();
     let mut rows = Vec::new();
     for (k, file) in selected.iter().enumerate() {
@@ -153,7 +155,7 @@ pub fn run_all(
         out.join("summary.md").display()
     );
     if only.is_empty() && shard.is_none() {
-        write_results(root, out, &summary)?;
+        write_results(root, out, &summary, &revision)?;
         eprintln!("regenerated docs/results.md");
     } else {
         eprintln!("docs/results.md left as it was (not every scenario ran)");
@@ -419,7 +421,7 @@ fn commit(root: &Path) -> String {
 }
 
 /// Regenerate `docs/results.md` and copy each scenario's picture to `docs/img/results/`.
-fn write_results(root: &Path, out: &Path, s: &Summary) -> Result<()> {
+fn write_results(root: &Path, out: &Path, s: &Summary, revision: &str) -> Result<()> {
     let img = root.join("docs/img/results");
     std::fs::create_dir_all(&img)?;
     for r in &s.rows {
@@ -450,7 +452,7 @@ fn write_results(root: &Path, out: &Path, s: &Summary) -> Result<()> {
          a failed run still wrote its report and its outputs up to the last good frame, and its\n\
          picture below shows that frame. Wall times include loading, gridding and writing.\n\n",
     );
-    let _ = writeln!(md, "Run at commit {}.\n", commit(root));
+    let _ = writeln!(md, "Run at commit {revision}.\n");
     md.push_str(&summary_markdown(s, Some("img/results")));
     atelier_fabric::files::write_atomic(&root.join("docs/results.md"), md.as_bytes())?;
     Ok(())
