@@ -87,7 +87,7 @@ fn the_dress_is_sewn_on_the_mannequin_without_entering_it() {
     );
     assert_eq!(run.max_penetration, 0.0, "checked after every step");
     assert_eq!(run.steps_with_penetration, 0);
-    // Dressed: the bodice rests on the shoulders, the hem hangs above the knees' lower half.
+    // Dressed: the bodice rests on the shoulders, the hem hangs 60 cm below the waist.
     let last = &run.frames.last().expect("frames").cloth;
     let top = last.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max);
     let hem = last.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);

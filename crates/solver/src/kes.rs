@@ -110,16 +110,17 @@ pub fn values_of(points: &[(f64, f64)]) -> TensileValues {
     }
 }
 
-/// The KES-FB1 tensile test along `direction` over `path` (forces per width, N/m), holding each
-/// level `hold` steps of 0.01 s.
-pub fn tensile_test(
+/// The KES-FB1 specimen: nodes across (u), nodes along the load (v), width and gauge, m.
+pub const FB1_SPECIMEN: (usize, usize, f64, f64) = (21, 6, 0.20, 0.05);
+
+/// The KES-FB1 specimen along `direction` in the x–y plane, the load along y: its bottom row
+/// (nodes `0..nu`) clamped, its top row (the last `nu` nodes) free to be pulled.
+pub fn fb1_specimen(
     fabric: &Fabric,
     form: AnisotropyForm,
     direction: Direction,
-    path: &[f64],
-    hold: usize,
-) -> Result<TensileCurve, KesError> {
-    let (nu, nv, width, gauge) = (21, 6, 0.20, 0.05);
+) -> Result<(Cloth, ClothState), KesError> {
+    let (nu, nv, width, gauge) = FB1_SPECIMEN;
     let mut grid = StructuredGrid::sheet(nu, nv, width, gauge);
     // The sheet's warp runs along y (the load); a weft specimen turns the grain across.
     if direction == Direction::Weft {
@@ -132,7 +133,21 @@ pub fn tensile_test(
         let p = cloth.topology().rest_positions()[i];
         cloth.pin(i as u32, place(p), PinMotion::Fixed)?;
     }
-    let mut state = ClothState::placed(&cloth, place);
+    let state = ClothState::placed(&cloth, place);
+    Ok((cloth, state))
+}
+
+/// The KES-FB1 tensile test along `direction` over `path` (forces per width, N/m), holding each
+/// level `hold` steps of 0.01 s.
+pub fn tensile_test(
+    fabric: &Fabric,
+    form: AnisotropyForm,
+    direction: Direction,
+    path: &[f64],
+    hold: usize,
+) -> Result<TensileCurve, KesError> {
+    let (nu, nv, width, gauge) = FB1_SPECIMEN;
+    let (cloth, mut state) = fb1_specimen(fabric, form, direction)?;
     let params = StepParams {
         dt: 0.01,
         gravity: [0.0; 3],

@@ -2,9 +2,8 @@
 //! instruments load a specimen, must give back the characteristics it was built from.
 
 use atelier_fabric::{AnisotropyForm, Branch, TensileState, units};
-use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::kes::{self, Direction};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+use atelier_solver::{Solver, StepParams};
 use nalgebra::Vector3;
 
 use crate::common::fabric;
@@ -176,19 +175,10 @@ fn compliant_diagonals_shear_by_the_kes_stiffness() {
     use atelier_solver::ConstraintKind;
     let f = fabric("cotton_broad");
     let g = f.shear.as_ref().expect("KES shear values").stiffness;
-    let (nu, nv, width, gauge) = (21, 6, 0.20, 0.05);
+    let (nu, nv, width, _) = kes::FB1_SPECIMEN;
     let run = |kind: ConstraintKind, tau: f64| {
-        let topo = ClothTopology::from_structured(&StructuredGrid::sheet(nu, nv, width, gauge))
-            .expect("grid");
-        let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
-        let place = |[x, y]: [f64; 2]| Vector3::new(x, y, 0.0);
-        for i in 0..nu {
-            let p = cloth.topology().rest_positions()[i];
-            cloth
-                .pin(i as u32, place(p), PinMotion::Fixed)
-                .expect("pin");
-        }
-        let mut state = ClothState::placed(&cloth, place);
+        let (cloth, mut state) =
+            kes::fb1_specimen(&f, AnisotropyForm::Thesis, Direction::Warp).expect("specimen");
         let params = StepParams {
             dt: 0.01,
             gravity: [0.0; 3],
