@@ -246,10 +246,11 @@ pub fn place(
                     let first = ((ya.min(yb) - lo) / BIN).ceil().max(0.0) as usize;
                     let last = (((ya.max(yb) - lo) / BIN).floor() as usize).min(bins - 1);
                     for (bin, e) in ext.iter_mut().enumerate().take(last + 1).skip(first) {
-                        let t = if yb == ya {
-                            0.0
+                        let dy = yb - ya;
+                        let t = if dy.abs() > 0.0 {
+                            (height(bin) - ya) / dy
                         } else {
-                            (height(bin) - ya) / (yb - ya)
+                            0.0
                         };
                         let x = rest[a][0] + (rest[b][0] - rest[a][0]) * t;
                         *e = (e.0.min(x), e.1.max(x));

@@ -85,7 +85,7 @@ fn the_dress_is_sewn_on_the_mannequin_without_entering_it() {
         "a node went {:.2} mm inside the body",
         deepest * 1e3
     );
-    assert_eq!(run.max_penetration, 0.0, "checked after every step");
+    assert!(run.max_penetration <= 0.0, "checked after every step");
     assert_eq!(run.steps_with_penetration, 0);
     // Dressed: the bodice rests on the shoulders, the hem hangs 60 cm below the waist.
     let last = &run.frames.last().expect("frames").cloth;
@@ -119,8 +119,8 @@ fn the_dress_report_is_complete_and_sane() {
     let steps = (report.simulated_s / report.dt_s).round() as usize;
     assert_eq!(report.steps, steps);
     let m = |k: &str| report.metrics[k].unwrap_or_else(|| panic!("{k} measured"));
-    assert_eq!(m("unsewn_pairs"), 0.0);
-    assert_eq!(m("max_penetration_m"), 0.0);
+    assert!(m("unsewn_pairs") < 0.5);
+    assert!(m("max_penetration_m") <= 0.0);
     assert!(m("sewn_at_s") > 0.0 && m("sewn_at_s") < report.simulated_s);
     assert!(m("max_strain_error") < 1.0 && m("final_strain_error") < 0.5);
     assert!(m("kinetic_energy_j") >= 0.0 && m("kinetic_energy_j") < 0.1);
@@ -160,7 +160,7 @@ fn the_dress_walks_without_entering_the_body() {
         "a node went {:.2} mm inside the body",
         deepest * 1e3
     );
-    assert_eq!(run.max_penetration, 0.0);
+    assert!(run.max_penetration <= 0.0);
     assert!(
         run.max_motion_energy > 1e-3,
         "the dress moves with the body"
@@ -189,7 +189,7 @@ fn the_dress_is_dressed_through_the_body_by_one_sided_contact() {
     assert_eq!(run.pairs.0, run.pairs.1);
     assert!(all_finite(&run));
     // Once pushed through, no node is inside the body (the push's own steps are not counted).
-    assert_eq!(run.max_penetration, 0.0);
+    assert!(run.max_penetration <= 0.0);
     let last = run.frames.last().expect("frames");
     assert!(last.phase != atelier::Phase::Sewing);
     // The back panels ended behind the body: some node is behind the mannequin's back

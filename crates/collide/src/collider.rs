@@ -216,6 +216,10 @@ struct Body {
     max_displacement: f64,
 }
 
+/// A node's velocity change and contact plane from the transfer on rigid parts (`None`: no body
+/// point within reach).
+type PartTransfer = Option<(V3, Option<ContactPlane>)>;
+
 /// The collision stages. With no body and no self-collision it holds nothing and does nothing.
 pub struct Collider {
     params: ContactParams,
@@ -224,7 +228,7 @@ pub struct Collider {
     /// and contact planes. Without it they use the body's triangles.
     parts: Option<RigidParts>,
     /// Per node: velocity change and contact plane found by the parts transfer.
-    part_results: Vec<Option<(V3, Option<ContactPlane>)>>,
+    part_results: Vec<PartTransfer>,
     /// Per cloth node, the group of nodes that are one point of the garment (a seam's two
     /// sides): self-collision ignores a triangle with a node of the same group. Empty: every
     /// node is its own group.
@@ -516,37 +520,35 @@ impl Collider {
         self.part_results.resize(positions.len(), None);
         self.start_distance.clear();
         self.start_distance.resize(positions.len(), reach);
-        let find =
-            |(i, (out, dist)): (usize, (&mut Option<(V3, Option<ContactPlane>)>, &mut f64))| {
-                if inverse_masses[i] == 0.0 {
-                    return;
-                }
-                let Some(n) = parts.nearest(&positions[i], reach, false) else {
-                    return;
-                };
-                *dist = n.distance;
-                let dv = if transfer && n.distance >= -p.thickness {
-                    parts.velocity_change(&n)
-                } else {
-                    V3::zeros()
-                };
-                // One-sided: only where the cloth's inside faces the body, and not for a node deep
-                // inside (one passing through the body from its outside, met its far side).
-                let one_sided_miss = p.one_sided
-                    && ((!normals.is_empty() && normals[i].dot(&parts.place(&n, false).1) <= 0.0)
-                        || n.distance < -p.recovery_depth);
-                let plane =
-                    (with_planes && n.distance < p.plane_reach && !one_sided_miss).then(|| {
-                        let (q, normal) = parts.place(&n, true);
-                        ContactPlane {
-                            point: q + normal * p.thickness,
-                            normal,
-                            velocity: parts.velocity(&n),
-                            friction: p.material.friction,
-                        }
-                    });
-                *out = Some((dv, plane));
+        let find = |(i, (out, dist)): (usize, (&mut PartTransfer, &mut f64))| {
+            if inverse_masses[i] == 0.0 {
+                return;
+            }
+            let Some(n) = parts.nearest(&positions[i], reach, false) else {
+                return;
             };
+            *dist = n.distance;
+            let dv = if transfer && n.distance >= -p.thickness {
+                parts.velocity_change(&n)
+            } else {
+                V3::zeros()
+            };
+            // One-sided: only where the cloth's inside faces the body, and not for a node deep
+            // inside (one passing through the body from its outside, met its far side).
+            let one_sided_miss = p.one_sided
+                && ((!normals.is_empty() && normals[i].dot(&parts.place(&n, false).1) <= 0.0)
+                    || n.distance < -p.recovery_depth);
+            let plane = (with_planes && n.distance < p.plane_reach && !one_sided_miss).then(|| {
+                let (q, normal) = parts.place(&n, true);
+                ContactPlane {
+                    point: q + normal * p.thickness,
+                    normal,
+                    velocity: parts.velocity(&n),
+                    friction: p.material.friction,
+                }
+            });
+            *out = Some((dv, plane));
+        };
         if positions.len() >= 256 {
             self.part_results
                 .par_iter_mut()
@@ -792,8 +794,8 @@ impl Collider {
             out.velocity = Some(vi);
             out.exit += r.exit - r.mean;
             if is_cloth {
-                for k in 0..3 {
-                    out.cloth_dv.push((tri[k] as usize, r.vertex_dv[k]));
+                for (&k, dv) in tri.iter().zip(r.vertex_dv) {
+                    out.cloth_dv.push((k as usize, dv));
                 }
                 out.self_hits += 1;
             } else {
