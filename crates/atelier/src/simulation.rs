@@ -619,20 +619,21 @@ fn exposed_triangles(
             .position(|p| p.part == part)
             .expect("every labelled part is a mannequin part")
     };
-    let buried = |v: u32, own: usize| {
-        let p = rest.vertices[v as usize];
-        (0..parts.len())
-            .filter(|&k| k != own)
-            .any(|k| parts.rest_distance(k, &p) < -1e-3)
-    };
+    // Whether each vertex lies more than 1 mm inside a part other than its own (once per
+    // vertex, in parallel: a vertex is shared by about six triangles).
+    let buried: Vec<bool> = (0..rest.vertices.len())
+        .into_par_iter()
+        .map(|v| {
+            let (p, own) = (rest.vertices[v], index_of(rest.vertex_part[v]));
+            (0..parts.len())
+                .filter(|&k| k != own)
+                .any(|k| parts.rest_distance(k, &p) < -1e-3)
+        })
+        .collect();
     rest.triangles
         .iter()
-        .zip(&rest.triangle_part)
-        .filter(|(t, part)| {
-            let own = index_of(**part);
-            !t.iter().all(|&v| buried(v, own))
-        })
-        .map(|(t, _)| *t)
+        .filter(|t| !t.iter().all(|&v| buried[v as usize]))
+        .copied()
         .collect()
 }
 
