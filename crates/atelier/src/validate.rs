@@ -78,13 +78,15 @@ pub fn validate(path: &Path) -> Outcome {
         ));
     }
     // A file that reads as a scenario is one: its later checks (ranges, metric names, the
-    // files it names) carry no position, so they must not lose to another format's parse error.
+    // files it names) must not lose to another format's parse error.
     if let Ok(s) = atelier_fabric::files::load_ron::<crate::scenario::Scenario>(path) {
-        return s
-            .check()
-            .and_then(|()| s.check_files(&crate::run::base_of(path)))
+        return crate::scenario::Scenario::load(path)
+            .and_then(|_| {
+                s.check_files(&crate::run::base_of(path))
+                    .map_err(|e| FileError::from_invalid(path, e))
+            })
             .map(|()| Kind::Scenario)
-            .map_err(|e| (Some(Kind::Scenario), FileError::from_invalid(path, e)));
+            .map_err(|e| (Some(Kind::Scenario), e));
     }
     let attempts: [(Kind, &Check); 7] = [
         (Kind::Fabric, &|p| {
