@@ -258,6 +258,7 @@ fn stage_medians(fixture: &Fixture, steps: usize) -> StageMedians {
             collision: median_duration(&reports, |t| t.collision),
             transfer: median_duration(&reports, |t| t.transfer),
             update: median_duration(&reports, |t| t.update),
+            pressure: median_duration(&reports, |t| t.pressure),
         },
         total: median_duration(&reports, |t| t.total()),
         internal_iterations: [0, 1].map(|k| {

@@ -22,6 +22,16 @@ pub enum PinMotion {
         /// Hz.
         frequency: f64,
     },
+    /// Held at its anchor until `start`, then moved in a straight line towards `to` at `speed`,
+    /// and held there: a picked point dragged to a target (Yamada's user drag).
+    Ramp {
+        /// Target, m.
+        to: [f64; 3],
+        /// When the drag starts, s.
+        start: f64,
+        /// Speed along the line, m/s (> 0).
+        speed: f64,
+    },
 }
 
 /// A pinned node.
@@ -48,6 +58,15 @@ impl Pin {
                 self.anchor
                     + Vector3::from(amplitude) * (2.0 * std::f64::consts::PI * frequency * t).sin()
             }
+            PinMotion::Ramp { to, start, speed } => {
+                let d = Vector3::from(to) - self.anchor;
+                let l = d.norm();
+                if l == 0.0 {
+                    return self.anchor;
+                }
+                let s = (speed * (t - start)).clamp(0.0, l);
+                self.anchor + d * (s / l)
+            }
         }
     }
 }
@@ -73,7 +92,7 @@ pub enum ClothError {
         nodes: usize,
     },
     /// A pin anchor or motion is not finite.
-    #[error("pin on node {node} has a non-finite anchor or motion")]
+    #[error("pin on node {node} has a non-finite anchor or motion, or a ramp speed ≤ 0")]
     NotFinite {
         /// Node.
         node: u32,
@@ -85,7 +104,7 @@ pub enum ClothError {
 const SECANT_SHEAR_ANGLE: f64 = 2.0 * std::f64::consts::PI / 180.0;
 
 /// One piece of cloth: topology, materials, masses and pins. Immutable during a simulation
-/// (pins are set before the first step).
+/// (pins are set before the first step), except for a pin released with [`Cloth::unpin`].
 #[derive(Clone, Debug)]
 pub struct Cloth {
     topology: ClothTopology,
@@ -307,6 +326,12 @@ impl Cloth {
                 amplitude,
                 frequency,
             } => amplitude.iter().all(|x| x.is_finite()) && frequency.is_finite(),
+            PinMotion::Ramp { to, start, speed } => {
+                to.iter().all(|x| x.is_finite())
+                    && start.is_finite()
+                    && speed > 0.0
+                    && speed.is_finite()
+            }
         };
         if !(finite && anchor.iter().all(|x| x.is_finite())) {
             return Err(ClothError::NotFinite { node });
@@ -324,6 +349,27 @@ impl Cloth {
             k => self.pins[k as usize] = pin,
         }
         self.inv_mass[node as usize] = 0.0;
+        self.update_shares(node as usize);
+        Ok(())
+    }
+
+    /// Release `node`'s pin (nothing when it has none): it moves freely again with its mass.
+    /// Call [`crate::Solver::reset`] afterwards (the solver's cached estimates depend on pins).
+    pub fn unpin(&mut self, node: u32) -> Result<(), ClothError> {
+        let n = self.topology.node_count();
+        if node as usize >= n {
+            return Err(ClothError::NoSuchNode { node, nodes: n });
+        }
+        let k = self.pin_of[node as usize];
+        if k == NO_NODE {
+            return Ok(());
+        }
+        self.pins.swap_remove(k as usize);
+        if let Some(moved) = self.pins.get(k as usize) {
+            self.pin_of[moved.node as usize] = k;
+        }
+        self.pin_of[node as usize] = NO_NODE;
+        self.inv_mass[node as usize] = 1.0 / self.mass[node as usize];
         self.update_shares(node as usize);
         Ok(())
     }

@@ -21,6 +21,7 @@ pub mod scenes;
 pub mod shear;
 pub mod state;
 pub mod step;
+pub mod wet;
 
 pub use cloth::{Cloth, ClothError, ClothOptions, Incidence, Pin, PinMotion};
 pub use contact::BodyContact;

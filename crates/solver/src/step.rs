@@ -44,6 +44,8 @@ pub enum Stage {
     InternalForces,
     /// Unconstrained velocity.
     Velocity,
+    /// The air pressure force of a wet cloth.
+    Pressure,
     /// Shape-constraint targets and iterations.
     ShapeConstraints,
     /// A collision pass (the hook).
@@ -115,6 +117,8 @@ pub struct StageTimings {
     pub transfer: Duration,
     /// Update and diagnostics.
     pub update: Duration,
+    /// The air pressure force ([`Solver::pressure`]; zero when off).
+    pub pressure: Duration,
 }
 
 impl StageTimings {
@@ -127,6 +131,7 @@ impl StageTimings {
             + self.shape
             + self.collision
             + self.update
+            + self.pressure
     }
 }
 
@@ -255,6 +260,10 @@ struct Scratch {
     plane_nodes: Vec<u32>,
     /// Nodes in a tie this step.
     tied: Vec<bool>,
+    /// Time spent in the pressure projections this step.
+    pressure_time: Duration,
+    /// The surface's reaction on the nodes lying on it (pressure stage only).
+    reaction: Vec<V3>,
     /// Node pairs held within a distance this step.
     ties: Vec<Tie>,
     vel: Vec<V3>,
@@ -282,6 +291,11 @@ pub struct Solver {
     lambda: Option<[f64; 2]>,
     /// External forces per node (N) added in the next steps; empty for none.
     pub external_forces: Vec<V3>,
+    /// The air pressure of a wet cloth ([`crate::wet`]): its force at the start of the step joins
+    /// the external forces, and the shape iterations take the air's pressure at the end of the
+    /// step as a compliant volume constraint (`wet::pressure`, "Large steps"). None (the
+    /// default): no pressure, and nothing of it runs.
+    pub pressure: Option<crate::wet::PressureStage>,
 }
 
 fn resize<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
@@ -487,6 +501,39 @@ impl Solver {
             return Err(non_finite(Stage::Bending, "bending force", "node", i));
         }
         report.timings.bending = t0.elapsed();
+        if let Some(p) = &mut self.pressure {
+            // The pressure predicted for the end of the step (backward Euler) from the
+            // velocities the other forces would give.
+            let t0 = Instant::now();
+            let (mass, areas, f) = (cloth.masses(), cloth.topology().node_areas(), &self.s.f_sum);
+            let vel0 = &state.velocities;
+            fill(&mut self.s.pred, |i| {
+                let c = params.damping * areas[i];
+                (vel0[i] * mass[i] + f[i] * dt) / (mass[i] + c * dt)
+            });
+            for pin in cloth.pins() {
+                let i = pin.node as usize;
+                self.s.pred[i] = (pin.position(state.time + dt) - state.positions[i]) / dt;
+            }
+            p.add_forces_predicted(
+                &state.positions,
+                &self.s.pred,
+                cloth.inverse_masses(),
+                dt,
+                &mut self.s.f_sum,
+            );
+            p.support(
+                &state.velocities,
+                cloth.inverse_masses(),
+                dt,
+                &mut self.s.f_sum,
+                &mut self.s.reaction,
+            );
+            if let Some(i) = first_non_finite_v(&self.s.f_sum) {
+                return Err(non_finite(Stage::Pressure, "pressure force", "node", i));
+            }
+            report.timings.pressure = t0.elapsed();
+        }
 
         // 2. Internal forces.
         let t0 = Instant::now();
@@ -511,6 +558,13 @@ impl Solver {
         self.gather(cloth, true);
         let e = self.energy(cloth);
         report.internal_residual = if e0 > 0.0 { e / e0 } else { 0.0 };
+        if self.pressure.is_some() {
+            // The surface's reaction was balanced in; the velocity carries the load into the
+            // surface again, so that the contact's friction feels it.
+            for (f, r) in self.s.f_m.iter_mut().zip(&self.s.reaction) {
+                *f -= r;
+            }
+        }
         if let Some(i) = first_non_finite(&self.s.p) {
             return Err(non_finite(Stage::InternalForces, "axial force", "edge", i));
         }
@@ -560,6 +614,7 @@ impl Solver {
             ));
         }
         let mut collision_time = Duration::ZERO;
+        self.s.pressure_time = Duration::ZERO;
         for pass in 0..params.collision_passes {
             let (iters, residual, cg) =
                 self.shape_iterations(cloth, state, params, report.tolerance_factor);
@@ -587,7 +642,8 @@ impl Solver {
             }
         }
         report.timings.collision = collision_time;
-        report.timings.shape = t0.elapsed() - collision_time;
+        report.timings.pressure += self.s.pressure_time;
+        report.timings.shape = t0.elapsed() - collision_time - self.s.pressure_time;
 
         // 5. Update and commit.
         let t0 = Instant::now();
@@ -1607,8 +1663,30 @@ impl Solver {
                 }
             }
             Self::project(s, cloth, state, dt, false);
+            if k % 4 == 3 {
+                self.project_pressure(cloth, state, dt);
+            }
         }
+        self.project_pressure(cloth, state, dt);
         (iterations, residual, cg_total)
+    }
+
+    /// The air's pressure at the end of the step as a constraint on the velocities (when a
+    /// pressure stage is on), then the hard constraints again; timed into `pressure_time`.
+    fn project_pressure(&mut self, cloth: &Cloth, state: &ClothState, dt: f64) {
+        if let Some(p) = &mut self.pressure {
+            let t0 = Instant::now();
+            let s = &mut self.s;
+            s.pred.copy_from_slice(&s.vel);
+            p.project(&state.positions, cloth.inverse_masses(), dt, &mut s.vel);
+            // The Chebyshev iteration extrapolates from the previous iterate: move it by the same
+            // change, so that the pressure's correction is not over-relaxed.
+            for ((prev, v), before) in s.vel_prev.iter_mut().zip(&s.vel).zip(&s.pred) {
+                *prev += v - before;
+            }
+            Self::project(s, cloth, state, dt, true);
+            self.s.pressure_time += t0.elapsed();
+        }
     }
 
     /// The hard constraints every shape iteration ends with: pins at their prescribed

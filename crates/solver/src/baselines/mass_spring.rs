@@ -8,7 +8,9 @@
 //! area (as [`crate::StepParams::damping`]) and `ṙ` the state's velocity, and optionally the
 //! isometric bending hinges described in [`crate::baselines`] (off by default: Yamada's model
 //! has no bending). Spring stiffness from the fabric: `k = W·E/l⁰`, see [`crate::baselines`].
-//! Contact, friction and air pressure (Y3.2)–(Y3.10) are not part of this baseline.
+//! Contact, friction and air pressure (Y3.2)–(Y3.10) are not part of the baseline itself; a scene
+//! adds them through [`SpringExtras`] ([`MassSpring::step_with`]; the wet cloth of
+//! [`crate::wet`]).
 //!
 //! Time stepping. The positions of the previous step are kept in the solver (position Verlet
 //! needs `P_{t−1}`); the velocity written back is `(P_{t+1} − P_t)/Δt`, the mid-step velocity.
@@ -49,6 +51,11 @@ pub struct MassSpringParams {
     /// Add the isometric bending hinges of [`crate::baselines`] with the fabric's rigidity B.
     /// Default false (Yamada's model has no bending).
     pub bending: bool,
+    /// Divergence guard: a step that starts with a spring stretched or shrunk by more than
+    /// this strain (|l/l⁰ − 1|) fails with `StepError::Diverged` and keeps the state. Range
+    /// above 0; default 10 (Yamada's soft springs legitimately reach strains of 2–3 under a
+    /// vacuum; a spring eleven times its length has diverged).
+    pub divergence_strain: f64,
 }
 
 impl Default for MassSpringParams {
@@ -59,6 +66,7 @@ impl Default for MassSpringParams {
             damping: 0.2,
             reference_force_fraction: 0.01,
             bending: false,
+            divergence_strain: 10.0,
         }
     }
 }
@@ -72,6 +80,12 @@ impl MassSpringParams {
             self.reference_force_fraction,
             self.reference_force_fraction > 0.0 && self.reference_force_fraction <= 1.0,
             "(0, 1]",
+        )?;
+        check(
+            "divergence_strain",
+            self.divergence_strain,
+            self.divergence_strain > 0.0,
+            "> 0",
         )
     }
 
@@ -79,6 +93,24 @@ impl MassSpringParams {
     pub fn gravity_vector(&self) -> V3 {
         V3::from(self.gravity)
     }
+}
+
+/// Forces and contacts a scene adds to the mass-spring step ([`MassSpring::step_with`]).
+pub trait SpringExtras {
+    /// Add forces at the start of the step, after the springs, gravity and damping (`forces`
+    /// holds their sum; an extra that depends on the total, such as a normal force, sees it).
+    fn add_forces(&mut self, cloth: &Cloth, state: &ClothState, dt: f64, forces: &mut [V3]);
+    /// Correct the positions `next` the Verlet update computed from `state` (contacts,
+    /// friction); pinned nodes must be left where they are.
+    fn correct(&mut self, cloth: &Cloth, state: &ClothState, dt: f64, next: &mut [V3]);
+}
+
+/// No extras: the plain baseline.
+pub struct NoExtras;
+
+impl SpringExtras for NoExtras {
+    fn add_forces(&mut self, _: &Cloth, _: &ClothState, _: f64, _: &mut [V3]) {}
+    fn correct(&mut self, _: &Cloth, _: &ClothState, _: f64, _: &mut [V3]) {}
 }
 
 /// The time and Δt of the last committed step (bit patterns), for which `previous` holds P_{t−1}.
@@ -93,6 +125,8 @@ struct History {
 #[derive(Clone, Debug, Default)]
 pub struct MassSpring {
     stiffness: Vec<f64>,
+    /// The stiffness was given ([`MassSpring::with_stiffness`]), not taken from the fabric.
+    given: bool,
     hinges: Vec<Hinge>,
     force: Vec<V3>,
     next: Vec<V3>,
@@ -105,6 +139,21 @@ impl MassSpring {
     /// A solver with empty scratch and no history.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A solver whose springs have the given stiffness, one per edge of the cloth it will step
+    /// (N/m), instead of the fabric's secant stiffness: Yamada's hand-set springs.
+    pub fn with_stiffness(stiffness: Vec<f64>) -> Self {
+        Self {
+            stiffness,
+            given: true,
+            ..Self::default()
+        }
+    }
+
+    /// The spring stiffness of every edge in the last step, N/m.
+    pub fn stiffness(&self) -> &[f64] {
+        &self.stiffness
     }
 
     /// Forget the previous positions: the next step starts the Verlet recursion afresh from the
@@ -121,6 +170,17 @@ impl MassSpring {
         state: &mut ClothState,
         params: &MassSpringParams,
     ) -> Result<BaselineReport, StepError> {
+        self.step_with(cloth, state, params, &mut NoExtras)
+    }
+
+    /// One step with a scene's extra forces and contacts. On error the state is unchanged.
+    pub fn step_with(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &MassSpringParams,
+        extras: &mut dyn SpringExtras,
+    ) -> Result<BaselineReport, StepError> {
         params.validate()?;
         check_input(cloth, state)?;
         let topo = cloth.topology();
@@ -129,7 +189,15 @@ impl MassSpring {
         resize(&mut self.force, n, V3::zeros());
         resize(&mut self.next, n, V3::zeros());
         resize(&mut self.velocity, n, V3::zeros());
-        fill_stiffness(cloth, params.reference_force_fraction, &mut self.stiffness);
+        if !self.given {
+            fill_stiffness(cloth, params.reference_force_fraction, &mut self.stiffness);
+        } else if self.stiffness.len() != topo.edges().len() {
+            return Err(StepError::Mismatch {
+                what: "spring stiffnesses",
+                expected: topo.edges().len(),
+                found: self.stiffness.len(),
+            });
+        }
         let (pos, vel) = (&state.positions, &state.velocities);
 
         // 1. Bending hinges (optional).
@@ -148,15 +216,28 @@ impl MassSpring {
         }
 
         // 2. Springs (Y3.6), gravity, damping.
-        for (edge, &k) in topo.edges().iter().zip(&self.stiffness) {
+        let mut worst = (0, 0.0);
+        for (e, (edge, &k)) in topo.edges().iter().zip(&self.stiffness).enumerate() {
             let (a, b) = (edge.a as usize, edge.b as usize);
             let d = pos[b] - pos[a];
             let l = d.norm();
+            let strain = (l - edge.rest_length).abs() / edge.rest_length;
+            if strain > worst.1 {
+                worst = (e, strain);
+            }
             if l > 0.0 {
                 let f = d * (k * (l - edge.rest_length) / l);
                 self.force[a] += f;
                 self.force[b] -= f;
             }
+        }
+        if worst.1 > params.divergence_strain {
+            return Err(StepError::Diverged {
+                edge: worst.0,
+                strain: worst.1,
+                limit: params.divergence_strain,
+                time,
+            });
         }
         let (g, c) = (params.gravity_vector(), params.damping);
         for (((f, &m), &s), v) in self
@@ -168,6 +249,7 @@ impl MassSpring {
         {
             *f += g * m - v * (c * s);
         }
+        extras.add_forces(cloth, state, dt, &mut self.force);
         if let Some(i) = first_non_finite(&self.force) {
             return Err(non_finite(Stage::InternalForces, "force", "node", i, time));
         }
@@ -192,6 +274,7 @@ impl MassSpring {
         for pin in cloth.pins() {
             self.next[pin.node as usize] = pin.position(time + dt);
         }
+        extras.correct(cloth, state, dt, &mut self.next);
         for ((v, x1), x0) in self.velocity.iter_mut().zip(&self.next).zip(pos) {
             *v = (x1 - x0) / dt;
         }

@@ -51,7 +51,7 @@
 pub mod mass_spring;
 pub mod xpbd;
 
-pub use mass_spring::{MassSpring, MassSpringParams};
+pub use mass_spring::{MassSpring, MassSpringParams, NoExtras, SpringExtras};
 pub use xpbd::{Xpbd, XpbdParams};
 
 use atelier_fabric::{Branch, TensileLoop};
