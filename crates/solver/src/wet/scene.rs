@@ -19,7 +19,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::contact::{PlaneContact, PlaneHook, YamadaExtras};
-use super::pressure::{Bubbles, PressureModel, PressureParams, Surface};
+use super::pressure::{ATMOSPHERE, Bubble, Bubbles, PressureModel, PressureParams, Surface};
 use super::stage::{NodeArea, PressureStage};
 use super::volume::{Plane, plane_volume};
 use crate::baselines::{MassSpring, MassSpringParams, spring_stiffnesses};
@@ -241,6 +241,9 @@ pub struct WetSample {
     pub bubbles: usize,
     /// The lowest and highest pressure of a sealed bubble, Pa; none without one.
     pub pressure_range: Option<[f64; 2]>,
+    /// The trapped air, as its volume at atmospheric pressure (Σ K / P_a), m³; none without
+    /// pressure.
+    pub air: Option<f64>,
     /// Cloth area with a node more than [`LIFTED`] above its rest height, m².
     pub lifted_area: f64,
     /// The highest node that is not held, above its rest height, m.
@@ -292,6 +295,8 @@ pub struct WetRun {
     pub particles: usize,
     /// Picked nodes.
     pub picked: Vec<u32>,
+    /// The bubbles at the end (none without pressure).
+    pub bubbles: Vec<Bubble>,
     /// Recorded frames (time, positions), the first at time 0 and the last the final state,
     /// when the scene asks for them.
     pub frames: Vec<(f64, Vec<V3>)>,
@@ -662,6 +667,7 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
             volume: plane_volume(pos, &triangles, &plane, scene.rest),
             pressure: report.map(|r| r.pressure),
             bubbles: report.map_or(0, |r| r.bubbles.len()),
+            air: report.map(|r| r.bubbles.iter().map(|b| b.air).sum::<f64>() / ATMOSPHERE),
             pressure_range: report.and_then(|r| {
                 r.bubbles
                     .iter()
@@ -749,6 +755,12 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
     if samples.last().map(|s| s.time) != Some(state.time) {
         samples.push(sample(&cloth, &state, &engine));
     }
+    let bubbles = match &engine {
+        Engine::Yamada { extras, .. } => extras.pressure.as_ref(),
+        Engine::Party { solver, .. } => solver.pressure.as_ref(),
+    }
+    .map(|p| p.report().bubbles.clone())
+    .unwrap_or_default();
     if scene.frame_interval.is_some() && frames.last().map(|f| f.0) != Some(state.time) {
         frames.push((state.time, state.positions.clone()));
     }
@@ -766,6 +778,7 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
         triangles,
         particles: scene.particles,
         picked,
+        bubbles,
         frames,
         failure,
     })

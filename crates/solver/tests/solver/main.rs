@@ -9,3 +9,4 @@ mod drape;
 mod hanging;
 mod kes;
 mod statics;
+mod wet;
