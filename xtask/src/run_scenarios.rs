@@ -298,6 +298,21 @@ fn key_metrics(r: &Report) -> String {
             f(m("two_hb_gf_cm_cm"), 4, ""),
             f(m("input_two_hb_gf_cm_cm"), 4, ""),
         ),
+        "Wet" => format!(
+            "tent {}, lifted {}, {} fold(s), P_b − P_a {}{}",
+            f(m("tent_height_mm"), 1, " mm"),
+            f(m("lifted_area_cm2"), 0, " cm²"),
+            f(m("folds"), 0, ""),
+            f(m("pressure_difference_pa"), 1, " Pa"),
+            match (m("compare_failed"), m("rms_difference_mm")) {
+                (Some(f), _) if f > 0.0 => format!(
+                    "; compared run stopped at {}",
+                    m("compare_simulated_s").map_or("–".into(), |t| format!("{t:.3} s"))
+                ),
+                (Some(_), Some(rms)) => format!("; {rms:.2} mm RMS from the compared run"),
+                _ => String::new(),
+            }
+        ),
         _ => String::new(),
     }
 }

@@ -18,6 +18,7 @@ pub mod scene;
 pub mod sewing;
 pub mod simulation;
 pub mod validate;
+pub mod wet;
 
 pub use assemble::{AssembleError, GarmentCloth};
 pub use scene::{Garment, GarmentSpec, Scene, SceneError, Settings};

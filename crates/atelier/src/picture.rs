@@ -250,3 +250,90 @@ pub fn garment_views(
     }
     out
 }
+
+/// Colour of the plane under a wet cloth.
+pub const PLANE: [f64; 3] = [0.55, 0.6, 0.68];
+
+/// A colour for a height `t` in [0, 1]: dark blue (on the plane) through teal to yellow.
+pub fn height_colour(t: f64) -> [f64; 3] {
+    let t = t.clamp(0.0, 1.0);
+    [
+        0.15 + 0.85 * t * t,
+        0.2 + 0.7 * t,
+        0.55 + 0.3 * t - 0.65 * t * t,
+    ]
+}
+
+/// A wet cloth (z up, on the plane z = 0, `size` its side) as two views, one scale: on the
+/// left seen from 35° above the plane and 30° round from −y, with the plane; on the right from
+/// straight above, coloured by height (dark on the plane, yellow at the top, the scale's top
+/// `top` metres) and shaded by slope, so that folds show. Returns the pixels of a `2w × h`
+/// picture.
+pub fn wet_views(
+    cloth: MeshRef<'_>,
+    size: f64,
+    top: f64,
+    w: usize,
+    h: usize,
+) -> Vec<Option<[f64; 3]>> {
+    let (points, triangles) = cloth;
+    let half = 0.6 * size;
+    // The plane: a square under the cloth, as two triangles after the cloth's.
+    let mut pts: Vec<[f64; 3]> = points.to_vec();
+    let base = pts.len() as u32;
+    let z = -0.002 * size;
+    pts.extend_from_slice(&[
+        [-half, -half, z],
+        [half, -half, z],
+        [half, half, z],
+        [-half, half, z],
+    ]);
+    let n_cloth = triangles.len();
+    let mut tris: Vec<[u32; 3]> = triangles.to_vec();
+    tris.extend_from_slice(&[[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+    // Both sides of the cloth.
+    let mut two_sided = tris.clone();
+    two_sided.extend(triangles.iter().map(|t| [t[0], t[2], t[1]]));
+    let cloth_of = |t: usize| t < n_cloth || t >= n_cloth + 2;
+    let (e, a) = (35f64.to_radians(), 30f64.to_radians());
+    let oblique = |p: &[f64; 3]| {
+        let (x, y) = (
+            p[0] * a.cos() - p[1] * a.sin(),
+            p[0] * a.sin() + p[1] * a.cos(),
+        );
+        [
+            x,
+            p[2] * e.cos() + y * e.sin(),
+            -y * e.cos() + p[2] * e.sin(),
+        ]
+    };
+    let mut out = vec![None; 2 * w * h];
+    // Left: oblique.
+    let view: Vec<[f64; 3]> = pts.iter().map(oblique).collect();
+    let (lo, hi) = screen_box(&view, View::Front);
+    let fit = Fit::new(lo, hi, w, h);
+    let colour = |t: usize| if cloth_of(t) { CLOTH } else { PLANE };
+    let left = render(&view, &two_sided, &colour, View::Front, fit, w, h);
+    // Right: from above, coloured by height.
+    let heights: Vec<f64> = two_sided
+        .iter()
+        .map(|t| t.iter().map(|&k| pts[k as usize][2]).sum::<f64>() / 3.0)
+        .collect();
+    let (lo, hi) = screen_box(&pts, View::Front);
+    let fit = Fit::new(lo, hi, w, h);
+    let colour = |t: usize| {
+        if cloth_of(t) {
+            height_colour(heights[t] / top.max(1e-9))
+        } else {
+            PLANE
+        }
+    };
+    let right = render(&pts, &two_sided, &colour, View::Front, fit, w, h);
+    for y in 0..h {
+        for x in 0..w {
+            out[y * 2 * w + x] = left[y * w + x];
+            out[y * 2 * w + w + x] = right[y * w + x];
+        }
+    }
+    out
+}

@@ -51,8 +51,32 @@ pub struct StageSeconds {
     /// The run's own diagnostics after each step (garment scenes: every node against the body).
     #[serde(default)]
     pub diagnostics: f64,
+    /// The air pressure of a wet cloth (wet scenes).
+    #[serde(default)]
+    pub pressure: f64,
     /// Sum of the stages.
     pub total: f64,
+}
+
+/// A second run of the same scene on another solver (wet scenes), with its cost (its metrics
+/// are the report's `compare_*` metrics).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Comparison {
+    /// `yamada` or `party`.
+    pub solver: String,
+    /// Its time step, s.
+    pub dt_s: f64,
+    /// Steps taken.
+    pub steps: usize,
+    /// Simulated time reached, s.
+    pub simulated_s: f64,
+    /// Wall time of its steps, s.
+    pub wall_s: f64,
+    /// Of which the pressure force, s.
+    pub pressure_s: f64,
+    /// The failure that ended it early (`null`: none).
+    pub failure: Option<String>,
 }
 
 /// One expectation and its outcome.
@@ -115,6 +139,9 @@ pub struct Report {
     pub failure: Option<String>,
     /// The files written beside the report.
     pub outputs: Vec<String>,
+    /// The compared run of a wet scene (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub comparison: Option<Comparison>,
 }
 
 impl Report {
@@ -135,6 +162,7 @@ impl Report {
             collision: t.collision.as_secs_f64(),
             update: t.update.as_secs_f64(),
             diagnostics: sim.timings.diagnostics.as_secs_f64(),
+            pressure: t.pressure.as_secs_f64(),
             total: sim.timings.total().as_secs_f64(),
         };
         Self {
@@ -163,6 +191,7 @@ impl Report {
             warnings: sim.warnings.clone(),
             failure: sim.failure.clone(),
             outputs: Vec::new(),
+            comparison: sim.comparison.clone(),
         }
     }
 

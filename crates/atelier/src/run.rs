@@ -92,6 +92,10 @@ pub struct Simulated {
     pub failure: Option<String>,
     /// A chart drawn instead of the final state's views (the virtual KES tests: the loop).
     pub chart: Option<crate::chart::Chart>,
+    /// The series, charts and second run of a wet scene.
+    pub wet: Option<Box<crate::wet::WetOutputs>>,
+    /// The compared run of a wet scene.
+    pub comparison: Option<crate::report::Comparison>,
 }
 
 /// Options of [`run`].
@@ -126,8 +130,18 @@ pub mod outputs {
     pub const PICTURE: &str = "final.png";
     /// View from above (drape tests).
     pub const TOP: &str = "top.png";
+    /// The compared run's final state (wet scenes).
+    pub const COMPARE: &str = "compare.png";
+    /// The series of a wet scene, one row per sample of each run.
+    pub const SERIES: &str = "series.csv";
+    /// Tent height over time (wet scenes).
+    pub const TENT: &str = "tent.png";
+    /// Trapped air's pressure over time (wet scenes).
+    pub const PRESSURE: &str = "pressure.png";
     /// Every name above.
-    pub const ALL: [&str; 6] = [REPORT, OBJ, PLY, GLB, PICTURE, TOP];
+    pub const ALL: [&str; 10] = [
+        REPORT, OBJ, PLY, GLB, PICTURE, TOP, COMPARE, SERIES, TENT, PRESSURE,
+    ];
 }
 
 /// Colour of the cloth in exports and pictures.
@@ -165,6 +179,7 @@ pub fn run(
         | ScenarioKind::Catenary(_)
         | ScenarioKind::KesTensile(_)
         | ScenarioKind::KesBending(_) => PictureStyle::Tilted,
+        ScenarioKind::Wet(_) => PictureStyle::Wet,
     };
     let (written, warnings) = write_outputs(&sim, out, &options, style)?;
     report.outputs = written;
@@ -182,6 +197,9 @@ enum PictureStyle {
     WithTop,
     /// Front and side of the scene tilted 35° about x (strips).
     Tilted,
+    /// A wet cloth: seen from above at an angle, and its height map (the compared run's in
+    /// `compare.png`).
+    Wet,
 }
 
 /// Create the output folder and remove temporary files a killed run may have left beside the
@@ -262,6 +280,10 @@ fn write_outputs(
     )?;
 
     let (w, h) = options.picture;
+    if let Some(wet) = &sim.wet {
+        write_wet_outputs(wet, &sim.cloth_triangles, out, (w, h), &mut written)?;
+        return Ok((written, warnings));
+    }
     let solid_final = solid_part
         .as_ref()
         .and_then(|(_, s)| s.motion.last().map(|p| (p, s.triangles.as_slice())));
@@ -304,6 +326,40 @@ fn write_outputs(
     Ok((written, warnings))
 }
 
+/// The pictures, series and charts of a wet scene.
+fn write_wet_outputs(
+    wet: &crate::wet::WetOutputs,
+    triangles: &[[u32; 3]],
+    out: &Path,
+    (w, h): (usize, usize),
+    written: &mut Vec<String>,
+) -> Result<(), RunError> {
+    let io = |path: PathBuf| move |source| RunError::Output { path, source };
+    // One height scale for both runs' pictures.
+    let top = std::iter::once(&wet.final_z_up)
+        .chain(wet.compare_z_up.as_ref())
+        .flatten()
+        .map(|p| p[2])
+        .fold(0.01, f64::max);
+    for (name, positions) in std::iter::once((outputs::PICTURE, &wet.final_z_up))
+        .chain(wet.compare_z_up.as_ref().map(|c| (outputs::COMPARE, c)))
+    {
+        let pixels = crate::picture::wet_views((positions, triangles), wet.size, top, w, h);
+        let path = out.join(name);
+        crate::picture::write_png(&path, &pixels, 2 * w, h, [1.0; 3]).map_err(io(path))?;
+        written.push(name.into());
+    }
+    let path = out.join(outputs::SERIES);
+    atelier_fabric::files::write_atomic(&path, wet.series_csv.as_bytes()).map_err(io(path))?;
+    written.push(outputs::SERIES.into());
+    for (name, chart) in &wet.charts {
+        let path = out.join(name);
+        crate::chart::write_chart(&path, chart, (2 * w as u32, h as u32)).map_err(io(path))?;
+        written.push((*name).into());
+    }
+    Ok(())
+}
+
 /// Check each expectation against the metrics.
 pub fn check_expectations(
     scenario: &Scenario,
@@ -340,6 +396,7 @@ pub fn simulate(
         ScenarioKind::Catenary(spec) => catenary(spec, &fabric, progress)?,
         ScenarioKind::KesTensile(spec) => kes_tensile(spec, &fabric)?,
         ScenarioKind::KesBending(spec) => kes_bending(spec, &fabric)?,
+        ScenarioKind::Wet(spec) => crate::wet::simulate(spec, &fabric)?,
     };
     sim.fabric = fabric.name.clone();
     trim_non_finite(&mut sim);
@@ -454,6 +511,8 @@ fn garment(
         warnings: run.warnings,
         failure: run.failure,
         chart: None,
+        wet: None,
+        comparison: None,
     })
 }
 
@@ -570,6 +629,8 @@ impl Stepper {
             warnings: Vec::new(),
             failure: self.failure,
             chart: None,
+            wet: None,
+            comparison: None,
         }
     }
 }
@@ -1119,5 +1180,7 @@ fn kes_simulated(
         warnings: Vec::new(),
         failure: None,
         chart: Some(chart),
+        wet: None,
+        comparison: None,
     })
 }

@@ -59,6 +59,9 @@ pub enum ScenarioKind {
     /// The KES-FB2 bending test on a simulated specimen: its loop's B and 2HB against the
     /// fabric's.
     KesBending(KesBendingSpec),
+    /// Yamada's wet cloth: a square on a plane, pinched and lifted over trapped air
+    /// ([`crate::wet`]), on one solver and optionally compared with another.
+    Wet(crate::wet::WetSpec),
 }
 
 impl ScenarioKind {
@@ -71,6 +74,7 @@ impl ScenarioKind {
             ScenarioKind::Catenary(_) => "Catenary",
             ScenarioKind::KesTensile(_) => "KesTensile",
             ScenarioKind::KesBending(_) => "KesBending",
+            ScenarioKind::Wet(_) => "Wet",
         }
     }
 
@@ -83,6 +87,7 @@ impl ScenarioKind {
             ScenarioKind::Catenary(s) => &s.fabric,
             ScenarioKind::KesTensile(s) => &s.fabric,
             ScenarioKind::KesBending(s) => &s.fabric,
+            ScenarioKind::Wet(s) => &s.fabric,
         }
     }
 
@@ -90,6 +95,7 @@ impl ScenarioKind {
     /// names; `docs/report.md` defines each.
     pub fn metric_names(&self) -> &'static [&'static str] {
         match self {
+            ScenarioKind::Wet(_) => crate::wet::METRICS,
             ScenarioKind::Garment(_) => &[
                 "nodes",
                 "cloth_triangles",
@@ -527,6 +533,42 @@ impl Scenario {
                         format!("{} levels: use 2 to 10000", k.levels),
                     );
                 }
+            }
+            ScenarioKind::Wet(w) => {
+                use atelier_solver::wet::scene::{WetError, WetSolver};
+                w.scene.validate().map_err(|e| match e {
+                    WetError::Range {
+                        field,
+                        value,
+                        range,
+                    } => InvalidValue::new(
+                        ErrorKind::OutOfRange,
+                        format!("kind.scene.{field}"),
+                        format!("{value} is outside {range}"),
+                    ),
+                    other => {
+                        InvalidValue::new(ErrorKind::OutOfRange, "kind.scene", other.to_string())
+                    }
+                })?;
+                for (field, solver) in std::iter::once(("kind.solver", &w.solver))
+                    .chain(w.compare.as_ref().map(|c| ("kind.compare", c)))
+                {
+                    let checked = match solver {
+                        WetSolver::Party(p) => p.validate(),
+                        WetSolver::Yamada(y) => atelier_solver::baselines::MassSpringParams {
+                            dt: y.dt,
+                            damping: y.damping,
+                            ..Default::default()
+                        }
+                        .validate(),
+                    };
+                    checked.map_err(|e| {
+                        InvalidValue::new(ErrorKind::OutOfRange, field, e.to_string())
+                    })?;
+                }
+                positive("kind.frame_interval", w.frame_interval)?;
+                positive("kind.fold_radius", w.fold_radius)?;
+                positive("kind.fold_prominence", w.fold_prominence)?;
             }
             ScenarioKind::KesBending(k) => {
                 if !(20..=100_000).contains(&k.steps_per_leg) {

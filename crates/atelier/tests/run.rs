@@ -287,3 +287,64 @@ fn virtual_kes_scenarios_give_back_the_fabrics_values() {
         std::fs::remove_dir_all(&out).ok();
     }
 }
+
+/// A small wet scene (15 × 15 particles over 300 cm³ of air, pinched 1 cm, 0.3 s) on the PARTY
+/// step, compared with Yamada's model: every wet metric is reported, the comparison carries
+/// the second run's cost, and the series, both pictures and both charts are written.
+#[test]
+fn a_wet_run_reports_both_solvers_and_writes_its_series() {
+    let text = format!(
+        r#"(
+    name: "small_wet",
+    reproduces: "a small wet pinch (test)",
+    kind: Wet(
+        fabric: "{}/fixtures/fabrics/polyester_satin_wet.ron",
+        scene: (
+            particles: 15,
+            pressure: (air: 3e-4),
+            picks: [(at: (0.5, 0.5), by: (0.0, 0.0, 0.01), speed: 0.05)],
+            duration: 0.3,
+        ),
+        solver: Party(dt: 0.005),
+        compare: Yamada(),
+    ),
+    expectations: [(metric: "tent_height_mm", min: 5.0)],
+)"#,
+        root().display()
+    );
+    let out = temp_dir("wet");
+    let report = run_text(&text, &out);
+    assert!(report.passed(), "{}", report.summary_line());
+    assert_eq!(report.scenario.kind, "Wet");
+    assert_eq!(report.nodes, 225);
+    for k in atelier::wet::METRICS {
+        assert!(report.metrics.contains_key(*k), "{k}");
+    }
+    let m = |k: &str| report.metrics[k].expect(k);
+    // Boyle's law in the final state, and both runs to the end.
+    assert!((m("air_cm3") - 300.0).abs() < 1e-6);
+    assert!((m("pressure_difference_pa")).abs() < 50.0);
+    assert!(m("compare_failed") < 0.5, "the compared run failed");
+    assert!(m("rms_difference_mm") < 5.0, "{}", m("rms_difference_mm"));
+    let c = report.comparison.as_ref().expect("comparison");
+    assert_eq!(c.solver, "yamada");
+    assert!((c.simulated_s - 0.3).abs() < 1e-6 && c.failure.is_none());
+    for name in [
+        outputs::PICTURE,
+        outputs::COMPARE,
+        outputs::SERIES,
+        outputs::TENT,
+        outputs::PRESSURE,
+    ] {
+        assert!(report.outputs.iter().any(|o| o == name), "{name}");
+        assert!(out.join(name).is_file(), "{name}");
+    }
+    let csv = std::fs::read_to_string(out.join(outputs::SERIES)).expect("series");
+    let rows: Vec<&str> = csv.lines().collect();
+    assert!(rows[0].starts_with("solver,time_s,volume_cm3"));
+    assert!(
+        rows.iter().any(|r| r.starts_with("party,"))
+            && rows.iter().any(|r| r.starts_with("yamada,"))
+    );
+    std::fs::remove_dir_all(&out).ok();
+}

@@ -50,6 +50,8 @@ pub struct YamadaExtras {
     pub pressure: Option<PressureStage>,
     /// Normal force |F_n| on each node this step, N.
     normal_force: Vec<f64>,
+    /// Wall time spent in the pressure force so far.
+    pub pressure_time: std::time::Duration,
 }
 
 impl YamadaExtras {
@@ -59,6 +61,7 @@ impl YamadaExtras {
             contact,
             pressure,
             normal_force: Vec::new(),
+            pressure_time: std::time::Duration::ZERO,
         }
     }
 }
@@ -66,7 +69,9 @@ impl YamadaExtras {
 impl SpringExtras for YamadaExtras {
     fn add_forces(&mut self, cloth: &Cloth, state: &ClothState, dt: f64, forces: &mut [V3]) {
         if let Some(p) = &mut self.pressure {
+            let t0 = std::time::Instant::now();
             p.add_forces(&state.positions, dt, forces);
+            self.pressure_time += t0.elapsed();
         }
         let Some(c) = &self.contact else {
             return;

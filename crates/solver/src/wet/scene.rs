@@ -279,7 +279,8 @@ pub struct WetRun {
     pub time: f64,
     /// Wall time of the steps (setup and sampling excluded).
     pub wall: Duration,
-    /// Wall time of the pressure force within the steps (zero without pressure).
+    /// Wall time of the pressure force within the steps (zero without pressure; Yamada's
+    /// timed around its evaluation, PARTY's as the step's pressure stage).
     pub pressure_wall: Duration,
     /// Wall time of building the cloth.
     pub setup: Duration,
@@ -323,7 +324,8 @@ pub struct Folds {
 }
 
 impl WetScene {
-    fn check(&self) -> Result<(), WetError> {
+    /// Check every field against its range (done again by [`run`] and [`WetScene::build`]).
+    pub fn validate(&self) -> Result<(), WetError> {
         let range = |field, value: f64, ok: bool, range| {
             if ok {
                 Ok(())
@@ -481,7 +483,7 @@ impl WetScene {
 
     /// The cloth (picks pinned with their ramps) and its state at time 0.
     pub fn build(&self, fabric: &Fabric) -> Result<(Cloth, ClothState), WetError> {
-        self.check()?;
+        self.validate()?;
         let n = self.particles;
         let grid = StructuredGrid::sheet(n, n, self.size, self.size);
         let topology = ClothTopology::from_structured(&grid)?;
@@ -646,9 +648,11 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
 
     let sample = |cloth: &Cloth, state: &ClothState, engine: &Engine| -> WetSample {
         let report = match engine {
-            Engine::Yamada { extras, .. } => extras.pressure.as_ref().map(|p| p.report()),
-            Engine::Party { solver, .. } => solver.pressure.as_ref().map(|p| p.report()),
-        };
+            Engine::Yamada { extras, .. } => extras.pressure.as_ref(),
+            Engine::Party { solver, .. } => solver.pressure.as_ref(),
+        }
+        .filter(|p| p.model().evaluated())
+        .map(|p| p.report());
         let pos = &state.positions;
         let plane = Plane::horizontal(0.0);
         let lifted_area = triangles
@@ -754,6 +758,9 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
     }
     if samples.last().map(|s| s.time) != Some(state.time) {
         samples.push(sample(&cloth, &state, &engine));
+    }
+    if let Engine::Yamada { extras, .. } = &engine {
+        pressure_wall = extras.pressure_time;
     }
     let bubbles = match &engine {
         Engine::Yamada { extras, .. } => extras.pressure.as_ref(),

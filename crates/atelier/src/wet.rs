@@ -1,0 +1,334 @@
+//! Wet-cloth scenarios (`ScenarioKind::Wet`; `docs/wet.md`): Yamada's experiment — a square of
+//! wet cloth on a plane, pinched and lifted, with or without air trapped under it
+//! ([`atelier_solver::wet::scene`]) — run on one solver, optionally compared with a run of the
+//! same scene on another, and measured: the bubble's volume and pressure over time, the lifted
+//! area, the tent's height, the folds around the first pinch, and between the two runs the RMS
+//! distance of their final nodes and their cost.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use atelier_fabric::Fabric;
+use atelier_solver::wet::ATMOSPHERE;
+use atelier_solver::wet::scene::{WetRun, WetScene, WetSolver, run};
+use serde::{Deserialize, Serialize};
+
+use crate::chart::{Chart, Series};
+use crate::export::Animation;
+use crate::report::Comparison;
+use crate::run::{RunError, Simulated};
+use crate::simulation::Timings;
+
+/// A wet-cloth scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WetSpec {
+    /// Fabric file (RON).
+    pub fabric: PathBuf,
+    /// The scene (size, particles, air, picks, duration; defaults: the thesis's 30 cm square of
+    /// 50 × 50 particles with no air).
+    #[serde(default)]
+    pub scene: WetScene,
+    /// The solver of the run whose outputs are written: `Yamada((...))` (the thesis's
+    /// mass-spring model, Δt 1/12 000 s by default) or `Party((dt: ...))` (the PARTY step).
+    pub solver: WetSolver,
+    /// A second run of the same scene to compare with (its metrics are prefixed `compare_`, its
+    /// cost is in the report's `comparison`). Default none.
+    #[serde(default)]
+    pub compare: Option<WetSolver>,
+    /// Interval between recorded frames, s. Default 0.04.
+    #[serde(default = "default_frame_interval")]
+    pub frame_interval: f64,
+    /// Radius of the circle (on the cloth, around the first pick) on which folds are counted, m.
+    /// Default 0.04.
+    #[serde(default = "default_fold_radius")]
+    pub fold_radius: f64,
+    /// Smallest prominence of a fold, m. Default 0.5 mm.
+    #[serde(default = "default_fold_prominence")]
+    pub fold_prominence: f64,
+}
+
+fn default_frame_interval() -> f64 {
+    0.04
+}
+fn default_fold_radius() -> f64 {
+    0.04
+}
+fn default_fold_prominence() -> f64 {
+    0.5e-3
+}
+
+/// The metrics of a wet scenario (units in the names; `docs/report.md`).
+pub const METRICS: &[&str] = &[
+    "nodes",
+    "cloth_triangles",
+    "simulated_s",
+    "frames",
+    "steps",
+    "bubble_volume_cm3",
+    "air_cm3",
+    "bubbles",
+    "pressure_difference_pa",
+    "min_pressure_difference_pa",
+    "max_pressure_difference_pa",
+    "lifted_area_cm2",
+    "tent_height_mm",
+    "pinch_height_mm",
+    "max_strain",
+    "max_speed_m_s",
+    "folds",
+    "fold_spacing_deviation_deg",
+    "fold_prominence_ratio",
+    "fold_ring_height_mm",
+    "compare_simulated_s",
+    "compare_failed",
+    "compare_tent_height_mm",
+    "compare_lifted_area_cm2",
+    "compare_folds",
+    "rms_difference_mm",
+];
+
+/// What a wet run adds to the usual outputs: the series, charts and the compared run's final
+/// state.
+#[derive(Clone, Debug)]
+pub struct WetOutputs {
+    /// `series.csv`: one row per sample of each run.
+    pub series_csv: String,
+    /// Charts by file name (`tent.png`, `pressure.png`).
+    pub charts: Vec<(&'static str, Chart)>,
+    /// Final positions of the main run, z up (for its picture).
+    pub final_z_up: Vec<[f64; 3]>,
+    /// Final positions of the compared run, z up.
+    pub compare_z_up: Option<Vec<[f64; 3]>>,
+    /// Side of the square cloth, m.
+    pub size: f64,
+}
+
+/// The metrics of one run (without the `compare_` ones).
+fn run_metrics(r: &WetRun, spec: &WetSpec) -> BTreeMap<String, Option<f64>> {
+    let last = r.last();
+    let rest = spec.scene.rest;
+    let pressures: Vec<f64> = r.samples[1..]
+        .iter()
+        .filter_map(|s| s.pressure.map(|p| p - ATMOSPHERE))
+        .collect();
+    let pinch = r
+        .picked
+        .iter()
+        .map(|&k| r.positions[k as usize].z - rest)
+        .fold(None, |m: Option<f64>, h| Some(m.map_or(h, |m| m.max(h))));
+    let folds = r
+        .picked
+        .first()
+        .map(|&k| r.folds(k, spec.fold_radius, spec.fold_prominence));
+    let mut m = BTreeMap::new();
+    let mut put = |k: &str, v: Option<f64>| {
+        m.insert(k.to_string(), v);
+    };
+    put("steps", Some(r.steps as f64));
+    put("bubble_volume_cm3", Some(last.volume * 1e6));
+    put("air_cm3", last.air.map(|a| a * 1e6));
+    put("bubbles", Some(last.bubbles as f64));
+    put(
+        "pressure_difference_pa",
+        last.pressure.map(|p| p - ATMOSPHERE),
+    );
+    put(
+        "min_pressure_difference_pa",
+        pressures.iter().copied().reduce(f64::min),
+    );
+    put(
+        "max_pressure_difference_pa",
+        pressures.iter().copied().reduce(f64::max),
+    );
+    put("lifted_area_cm2", Some(last.lifted_area * 1e4));
+    put("tent_height_mm", Some(last.tent_height * 1e3));
+    put("pinch_height_mm", pinch.map(|h| h * 1e3));
+    put("max_strain", Some(last.max_strain));
+    put("max_speed_m_s", Some(last.max_speed));
+    put("folds", folds.as_ref().map(|f| f.count as f64));
+    put(
+        "fold_spacing_deviation_deg",
+        folds.as_ref().map(|f| f.spacing_deviation_deg),
+    );
+    put(
+        "fold_prominence_ratio",
+        folds.as_ref().map(|f| f.prominence_ratio),
+    );
+    put(
+        "fold_ring_height_mm",
+        folds.as_ref().map(|f| (f.mean_height - rest) * 1e3),
+    );
+    m
+}
+
+/// The rows of `series.csv` for one run.
+fn series_rows(out: &mut String, r: &WetRun) {
+    use std::fmt::Write;
+    for s in &r.samples {
+        let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.9e}"));
+        let _ = writeln!(
+            out,
+            "{},{:.6},{:.9e},{},{},{},{:.9e},{:.9e},{:.9e},{:.9e}",
+            r.solver,
+            s.time,
+            s.volume * 1e6,
+            opt(s.pressure.map(|p| p - ATMOSPHERE)),
+            opt(s.air.map(|a| a * 1e6)),
+            s.bubbles,
+            s.lifted_area * 1e4,
+            s.tent_height * 1e3,
+            s.max_strain,
+            s.max_speed,
+        );
+    }
+}
+
+/// The z-up positions of a run's final state.
+fn z_up(r: &WetRun) -> Vec<[f64; 3]> {
+    r.positions.iter().map(|p| [p.x, p.y, p.z]).collect()
+}
+
+/// Run a wet scenario: the main run (its frames recorded), then the compared run if any.
+pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> {
+    let setup = |e: String| RunError::Setup(format!("wet scene: {e}"));
+    if !(spec.frame_interval > 0.0 && spec.frame_interval.is_finite()) {
+        return Err(setup(format!(
+            "`frame_interval` = {} is outside (0, ∞)",
+            spec.frame_interval
+        )));
+    }
+    if !(spec.fold_radius > 0.0 && spec.fold_radius < spec.scene.size) {
+        return Err(setup(format!(
+            "`fold_radius` = {} is outside (0, size)",
+            spec.fold_radius
+        )));
+    }
+    let scene = WetScene {
+        frame_interval: Some(spec.frame_interval),
+        ..spec.scene.clone()
+    };
+    let main = run(&scene, fabric, &spec.solver).map_err(|e| setup(e.to_string()))?;
+    let compared = match &spec.compare {
+        Some(solver) => Some(run(&spec.scene, fabric, solver).map_err(|e| setup(e.to_string()))?),
+        None => None,
+    };
+    let mut metrics = run_metrics(&main, spec);
+    let mut series_csv = String::from(
+        "solver,time_s,volume_cm3,pressure_difference_pa,air_cm3,bubbles,lifted_area_cm2,tent_height_mm,max_strain,max_speed_m_s\n",
+    );
+    series_rows(&mut series_csv, &main);
+    let mut comparison = None;
+    let mut warnings = Vec::new();
+    if let Some(c) = &compared {
+        series_rows(&mut series_csv, c);
+        let cm = run_metrics(c, spec);
+        let failed = c.failure.is_some();
+        metrics.insert(
+            "compare_simulated_s".into(),
+            Some((c.time * 1e9).round() / 1e9),
+        );
+        metrics.insert("compare_failed".into(), Some(f64::from(u8::from(failed))));
+        for (k, from) in [
+            ("compare_tent_height_mm", "tent_height_mm"),
+            ("compare_lifted_area_cm2", "lifted_area_cm2"),
+            ("compare_folds", "folds"),
+        ] {
+            metrics.insert(k.into(), cm.get(from).copied().flatten());
+        }
+        metrics.insert(
+            "rms_difference_mm".into(),
+            (!failed && main.failure.is_none()).then(|| main.rms_distance(c) * 1e3),
+        );
+        if let Some(f) = &c.failure {
+            warnings.push(format!(
+                "the compared {} run stopped at t = {:.3} s: {}",
+                c.solver, f.time, f.error
+            ));
+        }
+        comparison = Some(Comparison {
+            solver: c.solver.into(),
+            dt_s: c.dt,
+            steps: c.steps,
+            simulated_s: c.time,
+            wall_s: c.wall.as_secs_f64(),
+            pressure_s: c.pressure_wall.as_secs_f64(),
+            failure: c.failure.as_ref().map(|f| f.error.to_string()),
+        });
+    }
+    let charts = charts(&main, compared.as_ref());
+    let mut cloth = Animation::default();
+    for (t, frame) in &main.frames {
+        cloth.push(*t, frame.iter().map(|p| [p.x, p.z, -p.y]).collect());
+    }
+    let wet = WetOutputs {
+        series_csv,
+        charts,
+        final_z_up: z_up(&main),
+        compare_z_up: compared.as_ref().map(z_up),
+        size: spec.scene.size,
+    };
+    let mut timings = Timings::default();
+    timings.solver.pressure = main.pressure_wall;
+    Ok(Simulated {
+        fabric: String::new(),
+        cloth_triangles: main.triangles.clone(),
+        cloth,
+        solid: None,
+        steps: main.steps,
+        dt: main.dt,
+        simulated: main.time,
+        wall_seconds: main.wall.as_secs_f64(),
+        timings,
+        metrics,
+        warnings,
+        failure: main
+            .failure
+            .as_ref()
+            .map(|f| format!("t = {:.4} s: {}", f.time, f.error)),
+        chart: None,
+        wet: Some(Box::new(wet)),
+        comparison,
+    })
+}
+
+/// Tent height and pressure over time, one curve per run.
+fn charts(main: &WetRun, compared: Option<&WetRun>) -> Vec<(&'static str, Chart)> {
+    let runs: Vec<&WetRun> = std::iter::once(main).chain(compared).collect();
+    let curve =
+        |r: &WetRun, f: &dyn Fn(&atelier_solver::wet::scene::WetSample) -> Option<f64>| Series {
+            name: format!("{} (Δt {:.3} ms)", r.solver, r.dt * 1e3),
+            points: r
+                .samples
+                .iter()
+                .filter_map(|s| f(s).map(|v| (s.time, v)))
+                .collect(),
+        };
+    let mut out = vec![(
+        "tent.png",
+        Chart {
+            title: "tent height (highest free node above the plane)".into(),
+            x_label: "time (s)".into(),
+            y_label: "height (mm)".into(),
+            series: runs
+                .iter()
+                .map(|r| curve(r, &|s| Some(s.tent_height * 1e3)))
+                .collect(),
+        },
+    )];
+    if main.samples.iter().any(|s| s.pressure.is_some()) {
+        out.push((
+            "pressure.png",
+            Chart {
+                title: "trapped air: pressure above the atmosphere".into(),
+                x_label: "time (s)".into(),
+                y_label: "P_b − P_a (Pa)".into(),
+                series: runs
+                    .iter()
+                    .map(|r| curve(r, &|s| s.pressure.map(|p| p - ATMOSPHERE)))
+                    .collect(),
+            },
+        ));
+    }
+    out
+}
