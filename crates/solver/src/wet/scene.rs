@@ -324,6 +324,32 @@ pub struct Folds {
 }
 
 impl WetScene {
+    /// The thesis's demo (Figs. 4.3–4.6): the default square with `air` m³ of air under it (none:
+    /// dry), pinched at its centre (`points` = 1) or at two points 9 cm apart on its centre line
+    /// (`points` ≥ 2), lifted 2 cm at 2 cm/s from the start and held, for 1.5 s.
+    pub fn thesis_pinch(points: usize, air: Option<f64>) -> Self {
+        let pick = |x: f64| Pick {
+            at: [x, 0.5],
+            by: [0.0, 0.0, 0.02],
+            start: 0.0,
+            speed: 0.02,
+            release: None,
+        };
+        Self {
+            pressure: air.map(|air| PressureParams {
+                air,
+                ..PressureParams::default()
+            }),
+            picks: if points <= 1 {
+                vec![pick(0.5)]
+            } else {
+                vec![pick(0.35), pick(0.65)]
+            },
+            duration: 1.5,
+            ..Self::default()
+        }
+    }
+
     /// Check every field against its range (done again by [`run`] and [`WetScene::build`]).
     pub fn validate(&self) -> Result<(), WetError> {
         let range = |field, value: f64, ok: bool, range| {
@@ -473,7 +499,7 @@ impl WetScene {
     }
 
     /// The plane contact with the fabric's friction unless the scene gives its own.
-    fn contact(&self, fabric: &Fabric) -> PlaneContact {
+    pub fn contact(&self, fabric: &Fabric) -> PlaneContact {
         PlaneContact {
             plane: Plane::horizontal(0.0),
             rest: self.rest,
@@ -525,7 +551,7 @@ impl WetScene {
     }
 
     /// The pressure stage of the scene on `cloth` (none when the scene is dry).
-    fn pressure_stage(&self, cloth: &Cloth) -> Option<PressureStage> {
+    pub fn pressure_stage(&self, cloth: &Cloth) -> Option<PressureStage> {
         self.pressure.map(|p| {
             let model = PressureModel::new(
                 p,
@@ -894,32 +920,46 @@ impl WetRun {
 }
 
 /// The largest Δt in `[lo, hi]` at which `scene` runs to its end on `solver` (with that Δt)
-/// without a failed step and with no node ever faster than `max_speed` (m/s): bisection on a
-/// log scale, `halvings` times (the answer is within a factor `(hi/lo)^(1/2^halvings)` below the
-/// true limit; a limit below `lo` returns `lo`'s failure as `None`). Stability need not be
-/// monotonic in Δt; this finds one boundary.
+/// without a failed step and with no node ever faster than `max_speed` (m/s)
+/// ([`largest_dt_where`]).
 pub fn largest_stable_dt(
+    scene: &WetScene,
+    fabric: &Fabric,
+    solver: &WetSolver,
+    range: (f64, f64),
+    halvings: usize,
+    max_speed: f64,
+) -> Result<Option<f64>, WetError> {
+    largest_dt_where(scene, fabric, solver, range, halvings, &|r: &WetRun| {
+        r.failure.is_none() && r.samples.iter().all(|s| s.max_speed <= max_speed)
+    })
+}
+
+/// The largest Δt in `[lo, hi]` whose run of `scene` on `solver` (with that Δt) `accept`s:
+/// bisection on a log scale, `halvings` times (the answer lies within a factor
+/// `(hi/lo)^(1/2^halvings)` below the boundary found); `Some(hi)` when `hi` is accepted, `None`
+/// when `lo` is not. Acceptance need not be monotonic in Δt; this finds one boundary.
+pub fn largest_dt_where(
     scene: &WetScene,
     fabric: &Fabric,
     solver: &WetSolver,
     (lo, hi): (f64, f64),
     halvings: usize,
-    max_speed: f64,
+    accept: &dyn Fn(&WetRun) -> bool,
 ) -> Result<Option<f64>, WetError> {
-    let stable = |dt: f64| -> Result<bool, WetError> {
-        let r = run(scene, fabric, &solver.with_dt(dt))?;
-        Ok(r.failure.is_none() && r.samples.iter().all(|s| s.max_speed <= max_speed))
+    let ok = |dt: f64| -> Result<bool, WetError> {
+        Ok(accept(&run(scene, fabric, &solver.with_dt(dt))?))
     };
-    if stable(hi)? {
+    if ok(hi)? {
         return Ok(Some(hi));
     }
-    if !stable(lo)? {
+    if !ok(lo)? {
         return Ok(None);
     }
     let (mut a, mut b) = (lo.ln(), hi.ln());
     for _ in 0..halvings {
         let m = 0.5 * (a + b);
-        if stable(m.exp())? {
+        if ok(m.exp())? {
             a = m;
         } else {
             b = m;

@@ -14,26 +14,7 @@ const SATIN: &str = "polyester_satin_wet";
 
 /// The thesis's scene: one pick at the centre, or two 9 cm apart on the centre line.
 fn pinch(points: usize, air_cm3: Option<f64>) -> WetScene {
-    let pick = |x: f64| Pick {
-        at: [x, 0.5],
-        by: [0.0, 0.0, 0.02],
-        start: 0.0,
-        speed: 0.02,
-        release: None,
-    };
-    WetScene {
-        pressure: air_cm3.map(|a| PressureParams {
-            air: a * 1e-6,
-            ..PressureParams::default()
-        }),
-        picks: if points == 1 {
-            vec![pick(0.5)]
-        } else {
-            vec![pick(0.35), pick(0.65)]
-        },
-        duration: 1.5,
-        ..WetScene::default()
-    }
+    WetScene::thesis_pinch(points, air_cm3.map(|a| a * 1e-6))
 }
 
 /// The four Yamada runs (1 and 2 points, 0 and 400 cm³), computed once for the tests that
