@@ -9,6 +9,8 @@
 //!   images coloured by part and its error image.
 //! - `cargo xtask figures body [--out DIR]` — the mannequin at rest and walking (front and side),
 //!   the arm raise, and its range images with landmarks.
+//! - `cargo xtask figures wet [--out DIR]` — Yamada's wet-cloth model against the PARTY step:
+//!   the thesis's timing table re-measured, the largest stable Δt, the shape difference.
 //! - `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]` — every scenario of
 //!   `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on a full run
 //!   `docs/results.md` with its gallery; fails if a scenario fails or misses an expectation.
@@ -18,6 +20,7 @@ mod figures_fabric;
 mod figures_grid;
 mod figures_grid_body;
 mod figures_solver;
+mod figures_wet;
 mod plot;
 mod run_scenarios;
 
@@ -70,6 +73,9 @@ enum FigureSet {
     Grid,
     /// The mannequin at rest, walking and raising its arms; its range images.
     Body,
+    /// Wet cloth: Yamada's model against the PARTY step — timing table, largest stable Δt,
+    /// shape difference (takes a few minutes).
+    Wet,
 }
 
 /// A figure set's entry point: draw everything from the repository root into a folder, return
@@ -89,6 +95,7 @@ fn main() -> Result<()> {
                 FigureSet::Solver => ("solver", figures_solver::draw_all),
                 FigureSet::Grid => ("grid", figures_grid::draw_all),
                 FigureSet::Body => ("body", figures_body::draw_all),
+                FigureSet::Wet => ("wet", figures_wet::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;
