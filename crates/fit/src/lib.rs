@@ -11,6 +11,7 @@
 
 pub mod error;
 pub mod identify;
+pub mod rod;
 pub mod statics;
 pub mod string;
 

@@ -9,6 +9,39 @@ use nalgebra::{DMatrix, DVector};
 use crate::FitError;
 use crate::string::{StringModel, V2};
 
+/// A planar chain of particles held at both ends whose inner particles feel conservative forces:
+/// the string model, and the finer rod that stands in for a real object.
+pub trait Chain {
+    /// Particles.
+    fn particles(&self) -> usize;
+    /// Check the chain's own values.
+    fn validate(&self) -> Result<(), FitError>;
+    /// Potential energy of shape `x`, J.
+    fn energy(&self, x: &[V2]) -> f64;
+    /// Force on every particle (minus the energy's gradient), N.
+    fn forces(&self, x: &[V2], f: &mut [V2]);
+    /// ∂F/∂x, 2I × 2I.
+    fn force_jacobian(&self, x: &[V2]) -> DMatrix<f64>;
+}
+
+impl Chain for StringModel {
+    fn particles(&self) -> usize {
+        StringModel::particles(self)
+    }
+    fn validate(&self) -> Result<(), FitError> {
+        self.params.validate()
+    }
+    fn energy(&self, x: &[V2]) -> f64 {
+        StringModel::energy(self, x)
+    }
+    fn forces(&self, x: &[V2], f: &mut [V2]) {
+        StringModel::forces(self, x, f);
+    }
+    fn force_jacobian(&self, x: &[V2]) -> DMatrix<f64> {
+        StringModel::force_jacobian(self, x)
+    }
+}
+
 /// Settings of the static solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StaticOptions {
@@ -38,7 +71,7 @@ pub struct Equilibrium {
     pub residual: f64,
 }
 
-fn inner_forces(model: &StringModel, x: &[V2]) -> (DVector<f64>, f64, usize) {
+fn inner_forces<C: Chain + ?Sized>(model: &C, x: &[V2]) -> (DVector<f64>, f64, usize) {
     let mut f = vec![V2::zeros(); x.len()];
     model.forces(x, &mut f);
     let n = x.len() - 2;
@@ -57,123 +90,132 @@ fn inner_forces(model: &StringModel, x: &[V2]) -> (DVector<f64>, f64, usize) {
 }
 
 impl StringModel {
-    /// The static shape with its ends at `start`'s first and last positions, found from
-    /// `start` (validated: finite, the model's particle count, no two neighbours at one point).
+    /// The static shape with its ends at `start`'s first and last positions ([`equilibrium`]).
     pub fn equilibrium(
         &self,
         start: &[V2],
         options: &StaticOptions,
     ) -> Result<Equilibrium, FitError> {
-        self.params.validate()?;
-        let i = self.particles();
-        if start.len() != i {
-            return Err(FitError::invalid(
-                "start",
-                start.len(),
-                start.len() as f64,
-                format!("{} positions for a string of {i} particles", start.len()),
-            ));
+        equilibrium(self, start, options)
+    }
+}
+
+/// The static shape of `chain` with its ends at `start`'s first and last positions, found from
+/// `start` (validated: finite, the chain's particle count, no two neighbours at one point).
+pub fn equilibrium<C: Chain + ?Sized>(
+    chain: &C,
+    start: &[V2],
+    options: &StaticOptions,
+) -> Result<Equilibrium, FitError> {
+    chain.validate()?;
+    let i = chain.particles();
+    if start.len() != i {
+        return Err(FitError::invalid(
+            "start",
+            start.len(),
+            start.len() as f64,
+            format!("{} positions for a string of {i} particles", start.len()),
+        ));
+    }
+    if let Some(k) = start
+        .iter()
+        .position(|p| !(p.x.is_finite() && p.y.is_finite()))
+    {
+        return Err(FitError::invalid(
+            "start",
+            k,
+            f64::NAN,
+            "position not finite",
+        ));
+    }
+    if let Some(k) = (0..i - 1).find(|&k| (start[k + 1] - start[k]).norm() == 0.0) {
+        return Err(FitError::invalid(
+            "start",
+            k + 1,
+            0.0,
+            "at the same point as the particle before it",
+        ));
+    }
+    let n = i - 2;
+    let mut x = start.to_vec();
+    let mut energy = chain.energy(&x);
+    let mut shift = 0.0;
+    for iteration in 0..options.max_iterations {
+        let (g, worst, at) = inner_forces(chain, &x);
+        if worst < options.tolerance {
+            return Ok(Equilibrium {
+                positions: x,
+                iterations: iteration,
+                residual: worst,
+            });
         }
-        if let Some(k) = start
-            .iter()
-            .position(|p| !(p.x.is_finite() && p.y.is_finite()))
-        {
-            return Err(FitError::invalid(
-                "start",
-                k,
-                f64::NAN,
-                "position not finite",
-            ));
+        if !worst.is_finite() {
+            return Err(FitError::NoEquilibrium {
+                iterations: iteration,
+                residual: worst,
+                particle: at,
+            });
         }
-        if let Some(k) = (0..i - 1).find(|&k| (start[k + 1] - start[k]).norm() == 0.0) {
-            return Err(FitError::invalid(
-                "start",
-                k + 1,
-                0.0,
-                "at the same point as the particle before it",
-            ));
+        let j = chain.force_jacobian(&x);
+        let h: DMatrix<f64> = -j.view((2, 2), (2 * n, 2 * n));
+        let scale = h.diagonal().amax().max(1e-12);
+        // Newton step on the energy (gradient −g), shifted until the Hessian is positive
+        // definite and the energy falls.
+        let mut accepted = false;
+        for _ in 0..60 {
+            let shifted = &h + DMatrix::identity(2 * n, 2 * n) * (shift * scale);
+            if let Some(ch) = shifted.cholesky() {
+                let step = ch.solve(&g);
+                let mut t = 1.0;
+                for _ in 0..30 {
+                    let mut y = x.clone();
+                    for k in 0..n {
+                        y[k + 1] += V2::new(step[2 * k], step[2 * k + 1]) * t;
+                    }
+                    let e = chain.energy(&y);
+                    // Sufficient decrease of the energy; near the solution, where the
+                    // decrease is below the energy's rounding, a smaller force instead.
+                    let decrease = e <= energy + 1e-4 * t * (-g.dot(&step));
+                    let rounding = (e - energy).abs() <= 1e-12 * energy.abs().max(1e-300)
+                        && inner_forces(chain, &y).1 < worst;
+                    if e.is_finite() && (decrease || rounding) {
+                        x = y;
+                        energy = e;
+                        accepted = true;
+                        break;
+                    }
+                    t *= 0.5;
+                }
+            }
+            if accepted {
+                shift *= 0.1;
+                break;
+            }
+            shift = if shift == 0.0 { 1e-8 } else { shift * 10.0 };
         }
-        let n = i - 2;
-        let mut x = start.to_vec();
-        let mut energy = self.energy(&x);
-        let mut shift = 0.0;
-        for iteration in 0..options.max_iterations {
-            let (g, worst, at) = inner_forces(self, &x);
-            if worst < options.tolerance {
+        if !accepted {
+            // The energy no longer falls: converged as far as rounding allows.
+            let (_, worst, at) = inner_forces(chain, &x);
+            if worst < options.tolerance * 1e3 {
                 return Ok(Equilibrium {
                     positions: x,
-                    iterations: iteration,
-                    residual: worst,
-                });
-            }
-            if !worst.is_finite() {
-                return Err(FitError::NoEquilibrium {
-                    iterations: iteration,
-                    residual: worst,
-                    particle: at,
-                });
-            }
-            let j = self.force_jacobian(&x);
-            let h: DMatrix<f64> = -j.view((2, 2), (2 * n, 2 * n));
-            let scale = h.diagonal().amax().max(1e-12);
-            // Newton step on the energy (gradient −g), shifted until the Hessian is positive
-            // definite and the energy falls.
-            let mut accepted = false;
-            for _ in 0..60 {
-                let shifted = &h + DMatrix::identity(2 * n, 2 * n) * (shift * scale);
-                if let Some(ch) = shifted.cholesky() {
-                    let step = ch.solve(&g);
-                    let mut t = 1.0;
-                    for _ in 0..30 {
-                        let mut y = x.clone();
-                        for k in 0..n {
-                            y[k + 1] += V2::new(step[2 * k], step[2 * k + 1]) * t;
-                        }
-                        let e = self.energy(&y);
-                        // Sufficient decrease of the energy; near the solution, where the
-                        // decrease is below the energy's rounding, a smaller force instead.
-                        let decrease = e <= energy + 1e-4 * t * (-g.dot(&step));
-                        let rounding = (e - energy).abs() <= 1e-12 * energy.abs().max(1e-300)
-                            && inner_forces(self, &y).1 < worst;
-                        if e.is_finite() && (decrease || rounding) {
-                            x = y;
-                            energy = e;
-                            accepted = true;
-                            break;
-                        }
-                        t *= 0.5;
-                    }
-                }
-                if accepted {
-                    shift *= 0.1;
-                    break;
-                }
-                shift = if shift == 0.0 { 1e-8 } else { shift * 10.0 };
-            }
-            if !accepted {
-                // The energy no longer falls: converged as far as rounding allows.
-                let (_, worst, at) = inner_forces(self, &x);
-                if worst < options.tolerance * 1e3 {
-                    return Ok(Equilibrium {
-                        positions: x,
-                        iterations: iteration + 1,
-                        residual: worst,
-                    });
-                }
-                return Err(FitError::NoEquilibrium {
                     iterations: iteration + 1,
                     residual: worst,
-                    particle: at,
                 });
             }
+            return Err(FitError::NoEquilibrium {
+                iterations: iteration + 1,
+                residual: worst,
+                particle: at,
+            });
         }
-        let (_, worst, at) = inner_forces(self, &x);
-        Err(FitError::NoEquilibrium {
-            iterations: options.max_iterations,
-            residual: worst,
-            particle: at,
-        })
     }
+    let (_, worst, at) = inner_forces(chain, &x);
+    Err(FitError::NoEquilibrium {
+        iterations: options.max_iterations,
+        residual: worst,
+        particle: at,
+    })
 }
 
 #[cfg(test)]

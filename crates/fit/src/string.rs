@@ -149,19 +149,19 @@ pub struct StringModel {
 }
 
 /// ∂(angle of v)/∂v = perp(v)/|v|², perp(v) = (−v_y, v_x).
-fn angle_gradient(v: &V2) -> V2 {
+pub(crate) fn angle_gradient(v: &V2) -> V2 {
     V2::new(-v.y, v.x) / v.norm_squared()
 }
 
 /// ∂²(angle of v)/∂v² (symmetric).
-fn angle_hessian(v: &V2) -> Matrix2<f64> {
+pub(crate) fn angle_hessian(v: &V2) -> Matrix2<f64> {
     let n2 = v.norm_squared();
     let (x, y) = (v.x, v.y);
     Matrix2::new(2.0 * x * y, y * y - x * x, y * y - x * x, -2.0 * x * y) / (n2 * n2)
 }
 
 /// The signed turning angle from `e1` to `e2`, in (−π, π].
-fn turning(e1: &V2, e2: &V2) -> f64 {
+pub(crate) fn turning(e1: &V2, e2: &V2) -> f64 {
     (e1.x * e2.y - e1.y * e2.x).atan2(e1.dot(e2))
 }
 
