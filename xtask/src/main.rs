@@ -11,12 +11,15 @@
 //!   the arm raise, and its range images with landmarks.
 //! - `cargo xtask figures wet [--out DIR]` — Yamada's wet-cloth model against the PARTY step:
 //!   the thesis's timing table re-measured, the largest stable Δt, the shape difference.
+//! - `cargo xtask figures fit [--out DIR]` — the string-identification experiments on the
+//!   synthetic objects: Table 1, Fig. 11, Table 3 and the reproduced shapes.
 //! - `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]` — every scenario of
 //!   `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on a full run
 //!   `docs/results.md` with its gallery; fails if a scenario fails or misses an expectation.
 
 mod figures_body;
 mod figures_fabric;
+mod figures_fit;
 mod figures_grid;
 mod figures_grid_body;
 mod figures_solver;
@@ -76,6 +79,9 @@ enum FigureSet {
     /// Wet cloth: Yamada's model against the PARTY step — timing table, largest stable Δt,
     /// shape difference (takes a few minutes).
     Wet,
+    /// String identification (Sudoh et al.) on the synthetic objects: Table 1, Fig. 11,
+    /// Table 3 (about a minute).
+    Fit,
 }
 
 /// A figure set's entry point: draw everything from the repository root into a folder, return
@@ -96,6 +102,7 @@ fn main() -> Result<()> {
                 FigureSet::Grid => ("grid", figures_grid::draw_all),
                 FigureSet::Body => ("body", figures_body::draw_all),
                 FigureSet::Wet => ("wet", figures_wet::draw_all),
+                FigureSet::Fit => ("fit", figures_fit::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;

@@ -413,14 +413,16 @@ impl Scenario {
     pub fn load(path: &Path) -> Result<Self, FileError> {
         let text = std::fs::read_to_string(path).unwrap_or_default();
         let s: Scenario = atelier_fabric::files::load_ron(path)?;
-        s.check().map_err(|e| located(path, &text, e))?;
+        s.check()
+            .map_err(|e| atelier_fabric::files::located(path, &text, e))?;
         Ok(s)
     }
 
     /// Parse and check scenario text; `file` names it in errors.
     pub fn parse(text: &str, file: &Path) -> Result<Self, FileError> {
         let s: Scenario = atelier_fabric::files::parse_ron(text, file)?;
-        s.check().map_err(|e| located(file, text, e))?;
+        s.check()
+            .map_err(|e| atelier_fabric::files::located(file, text, e))?;
         Ok(s)
     }
 
@@ -648,83 +650,6 @@ impl Scenario {
         }
         Ok(())
     }
-}
-
-/// A check's error with the position of its field in the text: each segment of the field's path
-/// (`kind.settings.sewing.threshold`, `expectations[1].metric`) found as `name:` after the
-/// previous one, an index `[k]` as the `k`-th element of the list that follows; no position
-/// when a segment is not found (a value left to its default).
-fn located(file: &Path, text: &str, err: InvalidValue) -> FileError {
-    let mut at = Some(0);
-    for segment in err.field.split('.').filter(|s| !s.is_empty()) {
-        let (name, index) = match segment.split_once('[') {
-            Some((n, i)) => (n, i.trim_end_matches(']').parse::<usize>().ok()),
-            None => (segment, None),
-        };
-        at = at.and_then(|from| find_key(text, from, name));
-        if let Some(k) = index {
-            at = at.and_then(|from| list_element(text, from, k));
-        }
-    }
-    let mut e = FileError::from_invalid(file, err);
-    if let Some(at) = at.filter(|_| !e.field.is_empty()) {
-        let before = &text[..at];
-        let line = before.matches('\n').count() + 1;
-        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        e.position = Some(atelier_fabric::Position { line, column });
-    }
-    e
-}
-
-/// The byte offset of the `k`-th element of the first list (`[…]`) at or after `from`.
-fn list_element(text: &str, from: usize, k: usize) -> Option<usize> {
-    let open = from + text.get(from..)?.find('[')?;
-    let (mut depth, mut seen, mut expecting) = (0usize, 0usize, true);
-    for (offset, c) in text[open + 1..].char_indices() {
-        let at = open + 1 + offset;
-        match c {
-            '(' | '[' | '{' => {
-                if depth == 0 && expecting {
-                    if seen == k {
-                        return Some(at);
-                    }
-                    seen += 1;
-                    expecting = false;
-                }
-                depth += 1;
-            }
-            ')' | ']' | '}' if depth == 0 => return None,
-            ')' | ']' | '}' => depth -= 1,
-            ',' if depth == 0 => expecting = true,
-            c if c.is_whitespace() => {}
-            _ if depth == 0 && expecting => {
-                if seen == k {
-                    return Some(at);
-                }
-                seen += 1;
-                expecting = false;
-            }
-            _ => {}
-        }
-    }
-    None
-}
-
-/// The byte offset of the next `name` at or after `from` used as a key (`name:` or `name(`,
-/// not part of a longer word).
-fn find_key(text: &str, from: usize, name: &str) -> Option<usize> {
-    let mut start = from;
-    while let Some(k) = text.get(start..)?.find(name) {
-        let at = start + k;
-        let before = text[..at].chars().next_back();
-        let after = text[at + name.len()..].trim_start().chars().next();
-        let word = |c: char| c.is_alphanumeric() || c == '_';
-        if before.is_none_or(|c| !word(c)) && matches!(after, Some(':' | '(')) {
-            return Some(at);
-        }
-        start = at + name.len();
-    }
-    None
 }
 
 #[cfg(test)]

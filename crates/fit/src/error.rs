@@ -1,7 +1,5 @@
 //! The errors of `atelier-fit`.
 
-use std::path::PathBuf;
-
 /// What went wrong, with the field, position and value that caused it.
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
@@ -29,14 +27,10 @@ pub enum FitError {
         /// Where.
         particle: usize,
     },
-    /// A file that cannot be read or does not parse.
-    #[error("{}: {reason}", path.display())]
-    File {
-        /// The file.
-        path: PathBuf,
-        /// Why (with line:column and field where the parser gives them).
-        reason: String,
-    },
+    /// A file that cannot be read, does not parse or holds a value out of range (file,
+    /// line:column, field).
+    #[error(transparent)]
+    File(#[from] atelier_fabric::FileError),
 }
 
 impl FitError {

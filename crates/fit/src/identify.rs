@@ -14,7 +14,7 @@
 
 use std::cell::Cell;
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
 use nalgebra::storage::Owned;
 use nalgebra::{DMatrix, DVector, Dyn};
 use serde::{Deserialize, Serialize};
@@ -22,13 +22,20 @@ use serde::{Deserialize, Serialize};
 use crate::FitError;
 use crate::string::{STANDARD_GRAVITY, StringModel, StringParams, V2};
 
-/// Settings of the identification (defaults: the paper's).
+/// One gram-force, N.
+pub const GRAM_FORCE: f64 = 9.80665e-3;
+
+/// Settings of the identification (defaults: the paper's, with the units and iteration limit
+/// discussed at each field).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FitOptions {
     /// Weight of the shape error c_s, 1/m². Default 100.
     pub c_s: f64,
-    /// Weight of the force balance c_f, 1/N². Default 10.
+    /// Weight of the force balance c_f, 1/N². Default 10 per gram-force squared,
+    /// 10/(9.80665e-3)² = 1.04e5 N⁻² (the paper gives c_s = 100 and c_f = 10 without units; read
+    /// as per m² and per N² the balance is so weak that fitted shapes are far from equilibrium —
+    /// `docs/fit.md`).
     pub c_f: f64,
     /// Mass of each particle, kg. Default 1 g.
     pub mass: f64,
@@ -37,16 +44,21 @@ pub struct FitOptions {
     /// Levenberg–Marquardt gives up after `patience·(unknowns + 1)` residual evaluations.
     /// Default 100 (the crate's).
     pub patience: usize,
+    /// Iterations (Jacobian evaluations) at most; none: until a convergence criterion or the
+    /// patience. Default 200 (the paper stopped MATLAB's `lsqnonlin` at 50; this
+    /// Levenberg–Marquardt needs more on the same problems, `docs/fit.md`).
+    pub max_iterations: Option<usize>,
 }
 
 impl Default for FitOptions {
     fn default() -> Self {
         Self {
             c_s: 100.0,
-            c_f: 10.0,
+            c_f: 10.0 / (GRAM_FORCE * GRAM_FORCE),
             mass: 1e-3,
             gravity: [0.0, -STANDARD_GRAVITY],
             patience: 100,
+            max_iterations: Some(200),
         }
     }
 }
@@ -68,7 +80,8 @@ pub struct Fit {
     pub evaluations: usize,
     /// Why it stopped (the crate's termination reason).
     pub termination: String,
-    /// Whether it stopped on a convergence criterion (not on patience or a numerical failure).
+    /// Whether it stopped on a convergence criterion (not on the iteration limit, the patience
+    /// or a numerical failure).
     pub converged: bool,
 }
 
@@ -122,6 +135,36 @@ fn check_shape(shape: &[V2], j: usize) -> Result<(), FitError> {
     Ok(())
 }
 
+/// The parameters as Levenberg–Marquardt sees them: ln s, ln l, ln b, and φ through a logistic
+/// onto (0, 2π), so that no step makes a stiffness or a length negative or a natural bend leave
+/// its range (the paper's plain values have no such guard; `docs/fit.md`).
+fn encode(p: &StringParams) -> Vec<f64> {
+    let logit = |phi: f64| {
+        let u = phi / std::f64::consts::TAU;
+        (u / (1.0 - u)).ln()
+    };
+    p.stretch
+        .iter()
+        .chain(&p.length)
+        .chain(&p.bending)
+        .map(|v| v.ln())
+        .chain(p.natural_bend.iter().map(|&v| logit(v)))
+        .collect()
+}
+
+/// The inverse of [`encode`], and the derivative of each parameter by its encoded value.
+fn decode(particles: usize, q: &[f64]) -> (StringParams, Vec<f64>) {
+    let m = 3 * particles - 5;
+    let mut v: Vec<f64> = q[..m].iter().map(|x| x.exp()).collect();
+    let mut d = v.clone();
+    for x in &q[m..] {
+        let phi = std::f64::consts::TAU / (1.0 + (-x).exp());
+        v.push(phi);
+        d.push(phi * (1.0 - phi / std::f64::consts::TAU));
+    }
+    (StringParams::from_slice(particles, &v), d)
+}
+
 struct Problem<'a> {
     shapes: &'a [Vec<V2>],
     model: StringModel,
@@ -130,6 +173,7 @@ struct Problem<'a> {
     /// Inner positions of every shape, then the parameters.
     p: DVector<f64>,
     jacobians: Cell<usize>,
+    max_iterations: Option<usize>,
 }
 
 impl Problem<'_> {
@@ -145,7 +189,7 @@ impl Problem<'_> {
     fn model(&self) -> StringModel {
         let off = 2 * self.inner() * self.shapes.len();
         StringModel {
-            params: StringParams::from_slice(self.particles(), &self.p.as_slice()[off..]),
+            params: decode(self.particles(), &self.p.as_slice()[off..]).0,
             ..self.model.clone()
         }
     }
@@ -197,12 +241,20 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
+        if self
+            .max_iterations
+            .is_some_and(|m| self.jacobians.get() >= m)
+        {
+            // The iteration limit: stop here, keeping the last accepted step.
+            return None;
+        }
         self.jacobians.set(self.jacobians.get() + 1);
         let (n, jn) = (self.inner(), self.shapes.len());
         let model = self.model();
         let (ws, wf) = (self.c_s.sqrt(), self.c_f.sqrt());
         let cols = self.p.len();
         let off = 2 * n * jn;
+        let (_, dq) = decode(self.particles(), &self.p.as_slice()[off..]);
         let mut jac = DMatrix::zeros(4 * n * jn, cols);
         for j in 0..jn {
             let x = self.positions(j);
@@ -223,7 +275,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
                         }
                     }
                     for q in 0..dp.ncols() {
-                        jac[(row + 2 + c, off + q)] = wf * dp[(fr, q)];
+                        jac[(row + 2 + c, off + q)] = wf * dp[(fr, q)] * dq[q];
                     }
                 }
             }
@@ -296,7 +348,7 @@ pub fn identify(
         .iter()
         .flat_map(|s| s[1..=n].iter().flat_map(|q| [q.x, q.y]))
         .collect();
-    p.extend(initial.to_vec());
+    p.extend(encode(initial));
     let problem = Problem {
         shapes,
         model,
@@ -304,6 +356,7 @@ pub fn identify(
         c_f: options.c_f,
         p: DVector::from_vec(p),
         jacobians: Cell::new(0),
+        max_iterations: options.max_iterations,
     };
     let cost = |pr: &Problem| pr.residuals().map_or(f64::INFINITY, |r| r.norm_squared());
     let initial_cost = cost(&problem);
@@ -318,7 +371,15 @@ pub fn identify(
         cost: cost(&problem),
         iterations: problem.jacobians.get(),
         evaluations: report.number_of_evaluations,
-        termination: format!("{:?}", report.termination),
+        termination: if options
+            .max_iterations
+            .is_some_and(|m| problem.jacobians.get() >= m)
+            && matches!(report.termination, TerminationReason::User(_))
+        {
+            format!("iteration limit ({})", problem.jacobians.get())
+        } else {
+            format!("{:?}", report.termination)
+        },
         converged: report.termination.was_successful(),
     })
 }
@@ -358,7 +419,11 @@ mod tests {
             })
             .collect();
         let initial = initial_guess(&shapes[0], 6.0, 0.006).expect("guess");
-        let fit = identify(&shapes, &initial, &FitOptions::default()).expect("fit");
+        let options = FitOptions {
+            max_iterations: None,
+            ..FitOptions::default()
+        };
+        let fit = identify(&shapes, &initial, &options).expect("fit");
         eprintln!(
             "exact fit: {} iterations, {} evaluations, E_all {:e} → {:e} ({})",
             fit.iterations, fit.evaluations, fit.initial_cost, fit.cost, fit.termination

@@ -10,10 +10,13 @@
 //! [`string::StringModel::equilibrium`] then reproduces any shape for given end positions.
 
 pub mod error;
+pub mod experiment;
 pub mod identify;
+pub mod observation;
 pub mod rod;
 pub mod statics;
 pub mod string;
+pub mod synthetic;
 
 pub use error::FitError;
 pub use identify::{Fit, FitOptions, identify, initial_guess};
