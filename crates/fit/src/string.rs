@@ -42,7 +42,7 @@ pub struct StringParams {
     pub stretch: Vec<f64>,
     /// Natural lengths l_i, m (I − 1).
     pub length: Vec<f64>,
-    /// Bending coefficients b_k of the inner particles, N·m (I − 2).
+    /// Bending coefficients b_k of the inner particles, N·m, ≥ 0 (I − 2).
     pub bending: Vec<f64>,
     /// Natural bends φ_k of the inner particles, rad in (0, 2π) (π: straight) (I − 2).
     pub natural_bend: Vec<f64>,
@@ -86,8 +86,8 @@ impl StringParams {
         }
     }
 
-    /// Check the sizes and ranges: at least three particles, every value finite, s, l, b > 0,
-    /// φ in (0, 2π).
+    /// Check the sizes and ranges: at least three particles, every value finite, s, l > 0,
+    /// b ≥ 0, φ in (0, 2π).
     pub fn validate(&self) -> Result<(), FitError> {
         let i = self.particles();
         if i < 3 {
@@ -112,14 +112,23 @@ impl StringParams {
                 ));
             }
         }
-        for (field, v) in [
-            ("stretch", &self.stretch),
-            ("length", &self.length),
-            ("bending", &self.bending),
-        ] {
+        for (field, v) in [("stretch", &self.stretch), ("length", &self.length)] {
             if let Some(k) = v.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
                 return Err(FitError::invalid(field, k, v[k], "must be finite and > 0"));
             }
+        }
+        // No bending stiffness at a joint is a chain's: allowed.
+        if let Some(k) = self
+            .bending
+            .iter()
+            .position(|x| !(x.is_finite() && *x >= 0.0))
+        {
+            return Err(FitError::invalid(
+                "bending",
+                k,
+                self.bending[k],
+                "must be finite and ≥ 0",
+            ));
         }
         if let Some(k) = self
             .natural_bend
