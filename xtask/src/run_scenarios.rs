@@ -313,6 +313,15 @@ fn key_metrics(r: &Report) -> String {
                 _ => String::new(),
             }
         ),
+        "StringFit" => format!(
+            "J = {}: observed shapes reproduced to {} px (max {}), unobserved {} px, initial values {} px; {} iterations",
+            f(m("observed_shapes"), 0, ""),
+            f(m("mean_observed_error_px"), 2, ""),
+            f(m("max_observed_error_px"), 2, ""),
+            f(m("mean_unobserved_error_px"), 2, ""),
+            f(m("initial_unobserved_error_px"), 1, ""),
+            f(m("iterations"), 0, ""),
+        ),
         _ => String::new(),
     }
 }

@@ -27,6 +27,10 @@ pub struct Chart {
     pub y_label: String,
     /// The curves (the first drawn as a thick line, the others thin and on top).
     pub series: Vec<Series>,
+    /// Points drawn as open black circles over the curves (observed markers), if any.
+    pub markers: Option<Series>,
+    /// One scale on both axes (shapes), instead of each axis fitted to the data.
+    pub equal_aspect: bool,
 }
 
 /// Register the bundled font once; false when it cannot be loaded.
@@ -70,7 +74,11 @@ fn draw(
 ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
     let root = BitMapBackend::new(file, size).into_drawing_area();
     root.fill(&WHITE)?;
-    let all = chart.series.iter().flat_map(|s| s.points.iter());
+    let all = chart
+        .series
+        .iter()
+        .chain(&chart.markers)
+        .flat_map(|s| s.points.iter());
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -83,7 +91,15 @@ fn draw(
     if !(x1 > x0 && y1 > y0) {
         (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
     }
-    let (px, py) = (0.05 * (x1 - x0), 0.05 * (y1 - y0));
+    let (mut px, mut py) = (0.05 * (x1 - x0), 0.05 * (y1 - y0));
+    if chart.equal_aspect {
+        // Widen the narrower range so that a unit spans as many pixels on both axes (the plot
+        // area is about the picture less its label areas).
+        let (w, h) = (f64::from(size.0) - 96.0, f64::from(size.1) - 92.0);
+        let scale = ((x1 - x0 + 2.0 * px) / w).max((y1 - y0 + 2.0 * py) / h);
+        px = 0.5 * (scale * w - (x1 - x0));
+        py = 0.5 * (scale * h - (y1 - y0));
+    }
     let mut c = ChartBuilder::on(&root)
         .caption(&chart.title, ("sans-serif", 20))
         .margin(12)
@@ -104,6 +120,15 @@ fn draw(
         ))?
         .label(s.name.as_str())
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(3)));
+    }
+    if let Some(m) = &chart.markers {
+        c.draw_series(
+            m.points
+                .iter()
+                .map(|&p| Circle::new(p, 4, BLACK.stroke_width(1))),
+        )?
+        .label(m.name.as_str())
+        .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.stroke_width(1)));
     }
     c.configure_series_labels()
         .background_style(WHITE.mix(0.85))

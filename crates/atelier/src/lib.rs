@@ -8,6 +8,7 @@
 pub mod assemble;
 pub mod chart;
 pub mod export;
+pub mod fit;
 pub mod picture;
 pub mod pipeline;
 pub mod place;

@@ -94,6 +94,8 @@ pub struct Simulated {
     pub chart: Option<crate::chart::Chart>,
     /// The series, charts and second run of a wet scene.
     pub wet: Option<Box<crate::wet::WetOutputs>>,
+    /// The fitted parameters of a string identification.
+    pub fit: Option<Box<crate::fit::FitOutputs>>,
     /// The compared run of a wet scene.
     pub comparison: Option<crate::report::Comparison>,
 }
@@ -138,9 +140,11 @@ pub mod outputs {
     pub const TENT: &str = "tent.png";
     /// Trapped air's pressure over time (wet scenes).
     pub const PRESSURE: &str = "pressure.png";
+    /// String identification: the fitted model (RON).
+    pub const PARAMETERS: &str = "parameters.ron";
     /// Every name above.
-    pub const ALL: [&str; 10] = [
-        REPORT, OBJ, PLY, GLB, PICTURE, TOP, COMPARE, SERIES, TENT, PRESSURE,
+    pub const ALL: [&str; 11] = [
+        REPORT, OBJ, PLY, GLB, PICTURE, TOP, COMPARE, SERIES, TENT, PRESSURE, PARAMETERS,
     ];
 }
 
@@ -180,6 +184,7 @@ pub fn run(
         | ScenarioKind::KesTensile(_)
         | ScenarioKind::KesBending(_) => PictureStyle::Tilted,
         ScenarioKind::Wet(_) => PictureStyle::Wet,
+        ScenarioKind::StringFit(_) => PictureStyle::Tilted,
     };
     let (written, warnings) = write_outputs(&sim, out, &options, style)?;
     report.outputs = written;
@@ -236,6 +241,21 @@ fn write_outputs(
 ) -> Result<(Vec<String>, Vec<String>), RunError> {
     let mut written = Vec::new();
     let mut warnings = Vec::new();
+    if let Some(fit) = &sim.fit {
+        // A string identification: its parameters and the shapes' chart, no cloth.
+        let (w, h) = options.picture;
+        let io = |path: PathBuf| move |source| RunError::Output { path, source };
+        let path = out.join(outputs::PARAMETERS);
+        atelier_fabric::files::write_atomic(&path, fit.parameters_ron.as_bytes())
+            .map_err(io(path))?;
+        written.push(outputs::PARAMETERS.into());
+        if let Some(chart) = &sim.chart {
+            let path = out.join(outputs::PICTURE);
+            crate::chart::write_chart(&path, chart, (2 * w as u32, h as u32)).map_err(io(path))?;
+            written.push(outputs::PICTURE.into());
+        }
+        return Ok((written, warnings));
+    }
     let Some(final_cloth) = sim.cloth.last() else {
         warnings.push("no frame to write".into());
         return Ok((written, warnings));
@@ -387,7 +407,16 @@ pub fn simulate(
     base: &Path,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Simulated, RunError> {
-    let fabric_path = base.join(scenario.kind.fabric());
+    let Some(fabric_file) = scenario.kind.fabric() else {
+        // No cloth: the string identification.
+        let ScenarioKind::StringFit(spec) = &scenario.kind else {
+            unreachable!("every other kind names a fabric")
+        };
+        let sim = crate::fit::simulate(spec, base)?;
+        progress(1.0);
+        return Ok(sim);
+    };
+    let fabric_path = base.join(fabric_file);
     let fabric = Fabric::load(&fabric_path).map_err(|e| RunError::Setup(e.to_string()))?;
     let mut sim = match &scenario.kind {
         ScenarioKind::Garment(spec) => garment(spec, base, progress)?,
@@ -397,6 +426,7 @@ pub fn simulate(
         ScenarioKind::KesTensile(spec) => kes_tensile(spec, &fabric)?,
         ScenarioKind::KesBending(spec) => kes_bending(spec, &fabric)?,
         ScenarioKind::Wet(spec) => crate::wet::simulate(spec, &fabric)?,
+        ScenarioKind::StringFit(spec) => crate::fit::simulate(spec, base)?,
     };
     sim.fabric = fabric.name.clone();
     trim_non_finite(&mut sim);
@@ -512,6 +542,7 @@ fn garment(
         failure: run.failure,
         chart: None,
         wet: None,
+        fit: None,
         comparison: None,
     })
 }
@@ -630,6 +661,7 @@ impl Stepper {
             failure: self.failure,
             chart: None,
             wet: None,
+            fit: None,
             comparison: None,
         }
     }
@@ -1065,6 +1097,8 @@ fn kes_tensile(spec: &KesTensileSpec, fabric: &Fabric) -> Result<Simulated, RunE
                     .collect(),
             },
         ],
+        markers: None,
+        equal_aspect: false,
     };
     kes_simulated(
         curve.cloth,
@@ -1135,6 +1169,8 @@ fn kes_bending(spec: &KesBendingSpec, fabric: &Fabric) -> Result<Simulated, RunE
                 points: kes_pts(&mut curve.passes.iter().flatten().copied()),
             },
         ],
+        markers: None,
+        equal_aspect: false,
     };
     kes_simulated(
         curve.cloth,
@@ -1181,6 +1217,7 @@ fn kes_simulated(
         failure: None,
         chart: Some(chart),
         wet: None,
+        fit: None,
         comparison: None,
     })
 }

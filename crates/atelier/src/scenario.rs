@@ -62,6 +62,9 @@ pub enum ScenarioKind {
     /// Yamada's wet cloth: a square on a plane, pinched and lifted over trapped air
     /// ([`crate::wet`]), on one solver and optionally compared with another.
     Wet(crate::wet::WetSpec),
+    /// Sudoh et al.'s string identification ([`crate::fit`]): J observed shapes fitted,
+    /// reproduced, and the later shapes predicted.
+    StringFit(crate::fit::StringFitSpec),
 }
 
 impl ScenarioKind {
@@ -75,12 +78,13 @@ impl ScenarioKind {
             ScenarioKind::KesTensile(_) => "KesTensile",
             ScenarioKind::KesBending(_) => "KesBending",
             ScenarioKind::Wet(_) => "Wet",
+            ScenarioKind::StringFit(_) => "StringFit",
         }
     }
 
     /// The fabric file the scene uses.
-    pub fn fabric(&self) -> &Path {
-        match self {
+    pub fn fabric(&self) -> Option<&Path> {
+        Some(match self {
             ScenarioKind::Garment(s) => &s.fabric,
             ScenarioKind::Drape(s) => &s.fabric,
             ScenarioKind::Cantilever(s) => &s.fabric,
@@ -88,7 +92,8 @@ impl ScenarioKind {
             ScenarioKind::KesTensile(s) => &s.fabric,
             ScenarioKind::KesBending(s) => &s.fabric,
             ScenarioKind::Wet(s) => &s.fabric,
-        }
+            ScenarioKind::StringFit(_) => return None,
+        })
     }
 
     /// The metrics a run of this kind reports (the names expectations may use). Units are in the
@@ -96,6 +101,7 @@ impl ScenarioKind {
     pub fn metric_names(&self) -> &'static [&'static str] {
         match self {
             ScenarioKind::Wet(_) => crate::wet::METRICS,
+            ScenarioKind::StringFit(_) => crate::fit::METRICS,
             ScenarioKind::Garment(_) => &[
                 "nodes",
                 "cloth_triangles",
@@ -428,7 +434,19 @@ impl Scenario {
 
     /// The files the scenario names (resolved against `base`) exist and are files.
     pub fn check_files(&self, base: &Path) -> Result<(), InvalidValue> {
-        let mut files: Vec<(&str, &Path)> = vec![("kind.fabric", self.kind.fabric())];
+        let mut files: Vec<(&str, &Path)> = self
+            .kind
+            .fabric()
+            .map(|f| ("kind.fabric", f))
+            .into_iter()
+            .collect();
+        if let ScenarioKind::StringFit(crate::fit::StringFitSpec {
+            observations: crate::fit::Source::File(f),
+            ..
+        }) = &self.kind
+        {
+            files.push(("kind.observations", f));
+        }
         if let ScenarioKind::Garment(g) = &self.kind {
             files.push(("kind.garment", &g.garment));
             if let Some(b) = &g.body {
@@ -571,6 +589,29 @@ impl Scenario {
                 positive("kind.frame_interval", w.frame_interval)?;
                 positive("kind.fold_radius", w.fold_radius)?;
                 positive("kind.fold_prominence", w.fold_prominence)?;
+            }
+            ScenarioKind::StringFit(f) => {
+                if f.observed == 0 {
+                    return bad(
+                        "kind.observed",
+                        ErrorKind::OutOfRange,
+                        "0 shapes: fit at least 1".into(),
+                    );
+                }
+                if let Some(i) = &f.initial {
+                    positive("kind.initial.stretch", i.stretch)?;
+                    positive("kind.initial.bending", i.bending)?;
+                }
+                positive("kind.options.c_s", f.options.c_s)?;
+                positive("kind.options.c_f", f.options.c_f)?;
+                positive("kind.options.mass", f.options.mass)?;
+                if f.options.max_iterations == Some(0) {
+                    return bad(
+                        "kind.options.max_iterations",
+                        ErrorKind::OutOfRange,
+                        "0: use at least 1".into(),
+                    );
+                }
             }
             ScenarioKind::KesBending(k) => {
                 if !(20..=100_000).contains(&k.steps_per_leg) {

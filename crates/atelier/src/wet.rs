@@ -288,6 +288,7 @@ pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> 
             .map(|f| format!("t = {:.4} s: {}", f.time, f.error)),
         chart: None,
         wet: Some(Box::new(wet)),
+        fit: None,
         comparison,
     })
 }
@@ -314,6 +315,8 @@ fn charts(main: &WetRun, compared: Option<&WetRun>) -> Vec<(&'static str, Chart)
                 .iter()
                 .map(|r| curve(r, &|s| Some(s.tent_height * 1e3)))
                 .collect(),
+            markers: None,
+            equal_aspect: false,
         },
     )];
     if main.samples.iter().any(|s| s.pressure.is_some()) {
@@ -327,6 +330,8 @@ fn charts(main: &WetRun, compared: Option<&WetRun>) -> Vec<(&'static str, Chart)
                     .iter()
                     .map(|r| curve(r, &|s| s.pressure.map(|p| p - ATMOSPHERE)))
                     .collect(),
+                markers: None,
+                equal_aspect: false,
             },
         ));
     }

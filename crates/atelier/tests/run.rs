@@ -348,3 +348,66 @@ fn a_wet_run_reports_both_solvers_and_writes_its_series() {
     );
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// A string identification (Sudoh et al.) from an observation file: the synthetic rubber
+/// string written as RON, its first 4 shapes fitted from the paper's initial values, reproduced
+/// within the paper's largest error (1.68 px), the later shapes predicted within 2 px; every
+/// metric reported; the fitted model written as `parameters.ron` (it reads back and is valid)
+/// and the shapes as `final.png`. Without `initial` a file cannot start.
+#[test]
+fn a_string_fit_reports_its_errors_and_writes_its_parameters() {
+    use atelier_fit::synthetic::{Object, SyntheticOptions, observe};
+    let out = temp_dir("fit");
+    let (obs, _) = observe(Object::Rubber, &SyntheticOptions::default()).expect("observed");
+    let file = out.join("rubber.ron");
+    std::fs::write(&file, obs.to_ron()).expect("observations");
+    let scenario = |initial: &str| {
+        format!(
+            r#"(
+    name: "small_fit",
+    reproduces: "the rubber string fitted from a file (test)",
+    kind: StringFit(observations: File("{}"), observed: 4{initial}),
+    expectations: [(metric: "max_observed_error_px", max: 1.68)],
+)"#,
+            file.display()
+        )
+    };
+    let report = run_text(
+        &scenario(", initial: (stretch: 0.02, bending: 0.02)"),
+        &out.join("run"),
+    );
+    assert!(report.passed(), "{}", report.summary_line());
+    assert_eq!(report.scenario.kind, "StringFit");
+    for k in atelier::fit::METRICS {
+        assert!(report.metrics.contains_key(*k), "{k}");
+    }
+    let m = |k: &str| report.metrics[k].expect(k);
+    assert!(
+        m("mean_unobserved_error_px") < 2.0,
+        "{}",
+        m("mean_unobserved_error_px")
+    );
+    assert!(m("initial_unobserved_error_px") > m("mean_unobserved_error_px"));
+    assert_eq!(m("observed_shapes") as usize, 4);
+    assert_eq!(m("unobserved_shapes") as usize, 10);
+    for name in [outputs::PARAMETERS, outputs::PICTURE] {
+        assert!(out.join("run").join(name).is_file(), "{name}");
+    }
+    let text = std::fs::read_to_string(out.join("run").join(outputs::PARAMETERS)).expect("ron");
+    let model: atelier_fit::StringModel = ron::from_str(&text).expect("parameters read back");
+    model.params.validate().expect("valid parameters");
+    assert_eq!(model.particles(), 9);
+    // A file needs the initial s and b.
+    let s = Scenario::parse(&scenario(""), "s.ron".as_ref()).expect("parses");
+    let e = run(
+        &s,
+        None,
+        &root(),
+        &out.join("none"),
+        &RunOptions::default(),
+        &mut |_| {},
+    )
+    .expect_err("no initial values");
+    assert!(e.to_string().contains("initial"), "{e}");
+    std::fs::remove_dir_all(&out).ok();
+}

@@ -1,0 +1,234 @@
+//! String-identification scenarios (`ScenarioKind::StringFit`; `docs/fit.md`): the method of
+//! Sudoh et al. on one object's observations — the first J shapes fitted, each reproduced, the
+//! later shapes predicted by the fitted model and by the initial values — with the errors as
+//! metrics, the fitted parameters as `parameters.ron` and the shapes as `final.png`.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use atelier_fit::experiment::{fit, mean_error, paper_initial, reproduce};
+use atelier_fit::observation::Observations;
+use atelier_fit::synthetic::{Object, SyntheticOptions, observe};
+use atelier_fit::{FitOptions, StringModel, StringParams};
+use serde::{Deserialize, Serialize};
+
+use crate::chart::{Chart, Series};
+use crate::export::Animation;
+use crate::run::{RunError, Simulated};
+use crate::simulation::Timings;
+
+/// Where the observations come from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Source {
+    /// One of the synthetic objects (`atelier_fit::synthetic`), observed with the default
+    /// settings (20 shapes, 9 markers, σ = 0.5 px, seed 1).
+    Synthetic(Object),
+    /// An observation file (RON, `docs/fit.md`), relative to the scenario's folder.
+    File(PathBuf),
+}
+
+/// The initial s and b (l and φ come from the first shape).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Initial {
+    /// Every s, N.
+    pub stretch: f64,
+    /// Every b, N·m.
+    pub bending: f64,
+}
+
+/// A string-identification scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StringFitSpec {
+    /// The observations.
+    pub observations: Source,
+    /// J: the first J shapes are fitted (≥ 1).
+    pub observed: usize,
+    /// The shapes from this index on are predicted (unobserved). Default 10 (the paper's split
+    /// of 20 shapes).
+    #[serde(default = "default_unobserved_from")]
+    pub unobserved_from: usize,
+    /// Initial s and b; none: the paper's Table 2 for a synthetic object (required for a file).
+    #[serde(default)]
+    pub initial: Option<Initial>,
+    /// Fit settings (defaults: `docs/fit.md`).
+    #[serde(default)]
+    pub options: FitOptions,
+}
+
+fn default_unobserved_from() -> usize {
+    10
+}
+
+/// The metrics of a string-fit scenario (units in the names; `docs/report.md`).
+pub const METRICS: &[&str] = &[
+    "shapes",
+    "observed_shapes",
+    "unobserved_shapes",
+    "iterations",
+    "converged",
+    "initial_cost",
+    "cost",
+    "max_observed_error_px",
+    "mean_observed_error_px",
+    "mean_unobserved_error_px",
+    "initial_unobserved_error_px",
+    "fit_wall_s",
+];
+
+/// What a string-fit run adds: the fitted parameters.
+#[derive(Clone, Debug)]
+pub struct FitOutputs {
+    /// `parameters.ron`: the fitted model.
+    pub parameters_ron: String,
+}
+
+/// The observations of `spec` (`base`: the scenario's folder).
+fn load(spec: &StringFitSpec, base: &Path) -> Result<Observations, RunError> {
+    match &spec.observations {
+        Source::Synthetic(o) => observe(*o, &SyntheticOptions::default())
+            .map(|(obs, _)| obs)
+            .map_err(|e| RunError::Setup(format!("synthetic {}: {e}", o.name()))),
+        Source::File(p) => {
+            Observations::load(&base.join(p)).map_err(|e| RunError::Setup(e.to_string()))
+        }
+    }
+}
+
+/// The shapes of one object in image pixels (v up, for the chart): markers and a model shape.
+fn polyline(obs: &Observations, xs: &[atelier_fit::V2]) -> Vec<(f64, f64)> {
+    xs.iter()
+        .map(|x| {
+            let p = obs.to_pixels(x);
+            (p[0], f64::from(obs.image.1) - p[1])
+        })
+        .collect()
+}
+
+/// Run a string-fit scenario.
+pub fn simulate(spec: &StringFitSpec, base: &Path) -> Result<Simulated, RunError> {
+    let setup = |e: String| RunError::Setup(format!("string fit: {e}"));
+    let obs = load(spec, base)?;
+    let count = obs.shapes.len();
+    if spec.observed == 0 || spec.observed > count {
+        return Err(setup(format!(
+            "`observed` = {} must be 1 to the {count} shapes observed",
+            spec.observed
+        )));
+    }
+    let (s, b) = match (&spec.initial, &spec.observations) {
+        (Some(i), _) => (i.stretch, i.bending),
+        (None, Source::Synthetic(o)) => o.table2(),
+        (None, Source::File(_)) => {
+            return Err(setup(
+                "`initial` (stretch, bending) is needed for an observation file".into(),
+            ));
+        }
+    };
+    let initial: StringParams = paper_initial(&obs, 0, s, b).map_err(|e| setup(e.to_string()))?;
+    let observed: Vec<usize> = (0..spec.observed).collect();
+    let unobserved: Vec<usize> = (spec.unobserved_from.max(spec.observed)..count).collect();
+    let t0 = std::time::Instant::now();
+    let f = fit(&obs, &observed, &initial, &spec.options).map_err(|e| setup(e.to_string()))?;
+    let fit_wall = t0.elapsed().as_secs_f64();
+    let reproduced = reproduce(&f.model, &obs, &f.positions, &observed);
+    let predicted = reproduce(&f.model, &obs, &f.positions, &unobserved);
+    let guessed = reproduce(
+        &StringModel::new(initial),
+        &obs,
+        &[obs.shape(0)],
+        &unobserved,
+    );
+    let mut warnings = Vec::new();
+    for r in reproduced.iter().chain(&predicted) {
+        if r.error_px.is_none() {
+            warnings.push(format!(
+                "shape {}: the fitted model found no equilibrium on the way to it",
+                r.shape
+            ));
+        }
+    }
+    if !f.converged {
+        warnings.push(format!("the fit did not converge: {}", f.termination));
+    }
+    let errors: Vec<f64> = reproduced.iter().filter_map(|r| r.error_px).collect();
+    let mut metrics: BTreeMap<String, Option<f64>> = BTreeMap::new();
+    let mut put = |k: &str, v: Option<f64>| {
+        metrics.insert(k.into(), v);
+    };
+    put("shapes", Some(count as f64));
+    put("observed_shapes", Some(observed.len() as f64));
+    put("unobserved_shapes", Some(unobserved.len() as f64));
+    put("iterations", Some(f.iterations as f64));
+    put("converged", Some(f64::from(u8::from(f.converged))));
+    put("initial_cost", Some(f.initial_cost));
+    put("cost", Some(f.cost));
+    put(
+        "max_observed_error_px",
+        (errors.len() == reproduced.len()).then(|| errors.iter().copied().fold(0.0, f64::max)),
+    );
+    put("mean_observed_error_px", mean_error(&reproduced));
+    put("mean_unobserved_error_px", mean_error(&predicted));
+    put("initial_unobserved_error_px", mean_error(&guessed));
+    put("fit_wall_s", Some(fit_wall));
+    // The picture: every observed shape's markers and the model's reproduction (pixels, v up).
+    let mut series = Vec::new();
+    for r in &reproduced {
+        if !r.positions.is_empty() {
+            series.push(Series {
+                name: format!("model, shape {}", r.shape),
+                points: polyline(&obs, &r.positions),
+            });
+        }
+    }
+    let markers = Series {
+        name: "markers".into(),
+        points: observed
+            .iter()
+            .flat_map(|&j| obs.shapes[j].markers.iter())
+            .map(|p| (p[0], f64::from(obs.image.1) - p[1]))
+            .collect(),
+    };
+    let chart = Chart {
+        title: format!(
+            "{}: {} observed shapes fitted and reproduced",
+            obs.name, spec.observed
+        ),
+        x_label: "u, px".into(),
+        y_label: "height in the image, px".into(),
+        series,
+        markers: Some(markers),
+        equal_aspect: true,
+    };
+    let parameters_ron = {
+        let pretty = ron::ser::PrettyConfig::new().depth_limit(2);
+        let body = ron::ser::to_string_pretty(&f.model, pretty)
+            .map_err(|e| setup(format!("writing the parameters: {e}")))?;
+        format!(
+            "// The string model fitted to {} ({} shapes; docs/fit.md). SI units: s N, l m, b N·m, φ rad, mass kg.\n{body}\n",
+            obs.name, spec.observed
+        )
+    };
+    Ok(Simulated {
+        fabric: obs.name.clone(),
+        cloth_triangles: Vec::new(),
+        cloth: Animation {
+            times: Vec::new(),
+            frames: Vec::new(),
+        },
+        solid: None,
+        steps: f.iterations,
+        dt: 0.0,
+        simulated: 0.0,
+        wall_seconds: fit_wall,
+        timings: Timings::default(),
+        metrics,
+        warnings,
+        failure: None,
+        chart: Some(chart),
+        wet: None,
+        fit: Some(Box::new(FitOutputs { parameters_ron })),
+        comparison: None,
+    })
+}
