@@ -87,14 +87,7 @@ pub fn load_mesh(path: &Path) -> Result<ExternalBody, FileError> {
 
 /// [`load_mesh`] with options.
 pub fn load_mesh_with(path: &Path, opts: &LoadOptions) -> Result<ExternalBody, FileError> {
-    let text = std::fs::read_to_string(path).map_err(|e| FileError {
-        file: path.to_path_buf(),
-        position: None,
-        field: String::new(),
-        kind: ErrorKind::Io,
-        message: e.to_string(),
-        source: Some(e),
-    })?;
+    let text = atelier_fabric::files::read_text(path)?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())

@@ -94,16 +94,21 @@ fn find_key(text: &str, from: usize, name: &str) -> Option<usize> {
     None
 }
 
-/// Read and parse a RON file.
-pub fn load_ron<T: DeserializeOwned>(path: &Path) -> Result<T, FileError> {
-    let text = std::fs::read_to_string(path).map_err(|e| FileError {
+/// Read a text file, an I/O failure as a [`FileError`] naming it.
+pub fn read_text(path: &Path) -> Result<String, FileError> {
+    std::fs::read_to_string(path).map_err(|e| FileError {
         file: path.to_path_buf(),
         position: None,
         field: String::new(),
         kind: ErrorKind::Io,
         message: e.to_string(),
         source: Some(e),
-    })?;
+    })
+}
+
+/// Read and parse a RON file.
+pub fn load_ron<T: DeserializeOwned>(path: &Path) -> Result<T, FileError> {
+    let text = read_text(path)?;
     parse_ron(&text, path)
 }
 

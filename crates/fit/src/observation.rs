@@ -55,14 +55,7 @@ pub struct Observations {
 impl Observations {
     /// Read and check an observation file (errors name the file, line:column and field).
     pub fn load(path: &Path) -> Result<Self, FileError> {
-        let text = std::fs::read_to_string(path).map_err(|e| FileError {
-            file: path.to_path_buf(),
-            position: None,
-            field: String::new(),
-            kind: ErrorKind::Io,
-            message: e.to_string(),
-            source: Some(e),
-        })?;
+        let text = files::read_text(path)?;
         Self::parse(&text, path)
     }
 

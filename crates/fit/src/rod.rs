@@ -11,11 +11,13 @@
 //! linear in the angle, and EI/l̄ against b/φ), in mass (distributed against 1 g per particle)
 //! and in everything varying along it; so a fit cannot be exact and the test is honest.
 
-use nalgebra::{DMatrix, Matrix2};
+use nalgebra::DMatrix;
 
 use crate::FitError;
 use crate::statics::Chain;
-use crate::string::{STANDARD_GRAVITY, V2, angle_gradient, angle_hessian, turning};
+use crate::string::{
+    STANDARD_GRAVITY, V2, bend_forces, bend_jacobian, spring_forces, spring_jacobian, turning,
+};
 
 /// The rod.
 #[derive(Clone, Debug, PartialEq)]
@@ -167,64 +169,35 @@ impl Chain for Rod {
             *q = self.gravity * *m;
         }
         for i in 0..x.len() - 1 {
-            let d = x[i + 1] - x[i];
-            let len = d.norm();
-            let s = self.axial[i] * (len - self.rest[i]) / self.rest[i] * (d / len);
-            f[i] += s;
-            f[i + 1] -= s;
+            spring_forces(x, i, self.axial[i], self.rest[i], f);
         }
         for k in 1..x.len() - 1 {
-            let (e1, e2) = (x[k] - x[k - 1], x[k + 1] - x[k]);
-            let (p, d1, _) = psi(turning(&e1, &e2));
-            // F = −dE/dα · ∂α/∂x.
-            let c = -self.stiffness(k) * (p - psi(self.natural_turn[k - 1]).0) * d1;
-            let (g1, g2) = (angle_gradient(&e1), angle_gradient(&e2));
-            f[k - 1] += c * g1;
-            f[k] -= c * (g1 + g2);
-            f[k + 1] += c * g2;
+            let (d1, _) = self.bend_derivatives(x, k);
+            bend_forces(x, k, d1, f);
         }
     }
 
     fn force_jacobian(&self, x: &[V2]) -> DMatrix<f64> {
         let n = x.len();
         let mut j = DMatrix::zeros(2 * n, 2 * n);
-        let mut add = |a: usize, b: usize, m: &Matrix2<f64>| {
-            let mut v = j.fixed_view_mut::<2, 2>(2 * a, 2 * b);
-            v += m;
-        };
         for i in 0..n - 1 {
-            let d = x[i + 1] - x[i];
-            let len = d.norm();
-            let u = d / len;
-            let uu = u * u.transpose();
-            let k = (uu + (Matrix2::identity() - uu) * ((len - self.rest[i]) / len))
-                * (self.axial[i] / self.rest[i]);
-            add(i, i + 1, &k);
-            add(i, i, &-k);
-            add(i + 1, i + 1, &-k);
-            add(i + 1, i, &k);
+            spring_jacobian(x, i, self.axial[i], self.rest[i], &mut j);
         }
         for k in 1..n - 1 {
-            let (e1, e2) = (x[k] - x[k - 1], x[k + 1] - x[k]);
-            let (p, d1, d2) = psi(turning(&e1, &e2));
-            let kk = self.stiffness(k);
-            let diff = p - psi(self.natural_turn[k - 1]).0;
-            let (g1, g2) = (angle_gradient(&e1), angle_gradient(&e2));
-            // ∂α/∂x over (k−1, k, k+1), α = angle(e2) − angle(e1); F = −E'(α) ∂α/∂x, so
-            // ∂F/∂x = −(E''(α) ∂α/∂x ∂α/∂xᵀ + E'(α) ∂²α/∂x²).
-            let g = [g1, -(g1 + g2), g2];
-            let (t1, t2) = ([-1.0, 1.0, 0.0], [0.0, -1.0, 1.0]);
-            let (h1, h2) = (angle_hessian(&e1), angle_hessian(&e2));
-            for a in 0..3 {
-                for b in 0..3 {
-                    let hess = h2 * (t2[a] * t2[b]) - h1 * (t1[a] * t1[b]);
-                    let m = -(g[a] * g[b].transpose() * (kk * (d1 * d1 + diff * d2))
-                        + hess * (kk * diff * d1));
-                    add(k - 1 + a, k - 1 + b, &m);
-                }
-            }
+            let (d1, d2) = self.bend_derivatives(x, k);
+            bend_jacobian(x, k, d1, d2, &mut j);
         }
         j
+    }
+}
+
+impl Rod {
+    /// E'(α) and E''(α) of the bending energy `EI/l̄·(ψ − ψ⁰)²/2` at inner node k.
+    fn bend_derivatives(&self, x: &[V2], k: usize) -> (f64, f64) {
+        let (p, d1, d2) = psi(turning(&(x[k] - x[k - 1]), &(x[k + 1] - x[k])));
+        let kk = self.stiffness(k);
+        let diff = p - psi(self.natural_turn[k - 1]).0;
+        (kk * diff * d1, kk * (d1 * d1 + diff * d2))
     }
 }
 

@@ -174,6 +174,66 @@ pub(crate) fn turning(e1: &V2, e2: &V2) -> f64 {
     (e1.x * e2.y - e1.y * e2.x).atan2(e1.dot(e2))
 }
 
+/// A spring of stiffness `s` (force at 100 % strain) and rest length `l` between particles
+/// `i` and `i + 1`: its force (S1) added to `f`.
+pub(crate) fn spring_forces(x: &[V2], i: usize, s: f64, l: f64, f: &mut [V2]) {
+    let d = x[i + 1] - x[i];
+    let len = d.norm();
+    let force = s * (len - l) / l * (d / len);
+    f[i] += force;
+    f[i + 1] -= force;
+}
+
+/// The same spring's ∂F/∂x added to `j` (2I × 2I).
+pub(crate) fn spring_jacobian(x: &[V2], i: usize, s: f64, l: f64, j: &mut DMatrix<f64>) {
+    let d = x[i + 1] - x[i];
+    let len = d.norm();
+    let u = d / len;
+    let uu = u * u.transpose();
+    // F_i = S(d), F_{i+1} = −S(d), d = x_{i+1} − x_i, ∂S/∂d = k.
+    let k = (uu + (Matrix2::identity() - uu) * ((len - l) / len)) * (s / l);
+    for (a, b, m) in [(i, i + 1, k), (i, i, -k), (i + 1, i + 1, -k), (i + 1, i, k)] {
+        let mut v = j.fixed_view_mut::<2, 2>(2 * a, 2 * b);
+        v += m;
+    }
+}
+
+/// ∂α/∂x over particles (k − 1, k, k + 1) of the turning angle α at inner particle k
+/// (α = angle(e2) − angle(e1)).
+fn turning_gradient(x: &[V2], k: usize) -> [V2; 3] {
+    let (g1, g2) = (
+        angle_gradient(&(x[k] - x[k - 1])),
+        angle_gradient(&(x[k + 1] - x[k])),
+    );
+    [g1, -(g1 + g2), g2]
+}
+
+/// A bending energy E(α) at inner particle k, given its derivative `d1` = E'(α): its forces
+/// −E'·∂α/∂x added to `f`.
+pub(crate) fn bend_forces(x: &[V2], k: usize, d1: f64, f: &mut [V2]) {
+    for (a, g) in turning_gradient(x, k).iter().enumerate() {
+        f[k - 1 + a] -= g * d1;
+    }
+}
+
+/// The same bending energy's ∂F/∂x, −(E''·∂α/∂x ∂α/∂xᵀ + E'·∂²α/∂x²), added to `j`;
+/// `d2` = E''(α).
+pub(crate) fn bend_jacobian(x: &[V2], k: usize, d1: f64, d2: f64, j: &mut DMatrix<f64>) {
+    let (e1, e2) = (x[k] - x[k - 1], x[k + 1] - x[k]);
+    let g = turning_gradient(x, k);
+    // ∂e1/∂x: (−1, 1, 0); ∂e2/∂x: (0, −1, 1).
+    let (t1, t2) = ([-1.0, 1.0, 0.0], [0.0, -1.0, 1.0]);
+    let (h1, h2) = (angle_hessian(&e1), angle_hessian(&e2));
+    for a in 0..3 {
+        for b in 0..3 {
+            let hess = h2 * (t2[a] * t2[b]) - h1 * (t1[a] * t1[b]);
+            let m = -(g[a] * g[b].transpose() * d2 + hess * d1);
+            let mut v = j.fixed_view_mut::<2, 2>(2 * (k - 1 + a), 2 * (k - 1 + b));
+            v += m;
+        }
+    }
+}
+
 impl StringModel {
     /// The model with the paper's particle mass (1 g) and standard gravity.
     pub fn new(params: StringParams) -> Self {
@@ -219,22 +279,13 @@ impl StringModel {
         let p = &self.params;
         f.iter_mut().for_each(|q| *q = self.gravity * self.mass);
         for i in 0..x.len() - 1 {
-            let d = x[i + 1] - x[i];
-            let len = d.norm();
-            let s = p.stretch[i] * (len - p.length[i]) / p.length[i] * (d / len);
-            f[i] += s;
-            f[i + 1] -= s;
+            spring_forces(x, i, p.stretch[i], p.length[i], f);
         }
         for k in 1..x.len() - 1 {
-            let (e1, e2) = (x[k] - x[k - 1], x[k + 1] - x[k]);
+            // E = b(θ − φ)²/(2φ), θ = π − α: E'(α) = −b(θ − φ)/φ.
             let (b, phi) = (p.bending[k - 1], p.natural_bend[k - 1]);
-            let theta = std::f64::consts::PI - turning(&e1, &e2);
-            // F = −∂E/∂x = (b/φ)(θ − φ)·∂α/∂x, α = π − θ.
-            let c = b * (theta - phi) / phi;
-            let (g1, g2) = (angle_gradient(&e1), angle_gradient(&e2));
-            f[k - 1] += c * g1;
-            f[k] -= c * (g1 + g2);
-            f[k + 1] += c * g2;
+            let theta = Self::bend_angle(x, k);
+            bend_forces(x, k, -b * (theta - phi) / phi, f);
         }
     }
 
@@ -244,42 +295,13 @@ impl StringModel {
         let n = x.len();
         let p = &self.params;
         let mut j = DMatrix::zeros(2 * n, 2 * n);
-        let mut add = |a: usize, b: usize, m: &Matrix2<f64>| {
-            let mut v = j.fixed_view_mut::<2, 2>(2 * a, 2 * b);
-            v += m;
-        };
         for i in 0..n - 1 {
-            let d = x[i + 1] - x[i];
-            let len = d.norm();
-            let u = d / len;
-            let uu = u * u.transpose();
-            let k = (uu + (Matrix2::identity() - uu) * ((len - p.length[i]) / len))
-                * (p.stretch[i] / p.length[i]);
-            // F_i = S(d), F_{i+1} = −S(d), d = x_{i+1} − x_i, ∂S/∂d = k.
-            add(i, i + 1, &k);
-            add(i, i, &-k);
-            add(i + 1, i + 1, &-k);
-            add(i + 1, i, &k);
+            spring_jacobian(x, i, p.stretch[i], p.length[i], &mut j);
         }
         for k in 1..n - 1 {
-            let (e1, e2) = (x[k] - x[k - 1], x[k + 1] - x[k]);
             let (b, phi) = (p.bending[k - 1], p.natural_bend[k - 1]);
-            let theta = std::f64::consts::PI - turning(&e1, &e2);
-            let c = b * (theta - phi) / phi;
-            let (g1, g2) = (angle_gradient(&e1), angle_gradient(&e2));
-            // ∂α/∂x over (k−1, k, k+1); α = angle(e2) − angle(e1).
-            let g = [g1, -(g1 + g2), g2];
-            // ∂e1/∂x: (−1, 1, 0); ∂e2/∂x: (0, −1, 1).
-            let (t1, t2) = ([-1.0, 1.0, 0.0], [0.0, -1.0, 1.0]);
-            let (h1, h2) = (angle_hessian(&e1), angle_hessian(&e2));
-            for a in 0..3 {
-                for bb in 0..3 {
-                    // F_a = c g_a: ∂F_a/∂x_b = g_a (∂c/∂x_b)ᵀ + c ∂²α/∂x_a∂x_b, ∂c/∂x = −(b/φ) ∂α/∂x.
-                    let hess = h2 * (t2[a] * t2[bb]) - h1 * (t1[a] * t1[bb]);
-                    let m = g[a] * g[bb].transpose() * (-b / phi) + hess * c;
-                    add(k - 1 + a, k - 1 + bb, &m);
-                }
-            }
+            let theta = Self::bend_angle(x, k);
+            bend_jacobian(x, k, -b * (theta - phi) / phi, b / phi, &mut j);
         }
         j
     }
