@@ -74,13 +74,7 @@ pub fn reproduce(
                     Err(_) => return failed,
                 }
             }
-            let err = x[1..n - 1]
-                .iter()
-                .zip(&target[1..n - 1])
-                .map(|(p, q)| (p - q).norm())
-                .sum::<f64>()
-                / (n - 2) as f64
-                / obs.pixel_size;
+            let err = inner_distance_px(&x, &target, obs.pixel_size);
             Reproduced {
                 shape: j,
                 positions: x,
@@ -88,6 +82,32 @@ pub fn reproduce(
             }
         })
         .collect()
+}
+
+/// Mean distance of the inner particles of `positions` from `reference` (both metres), px.
+pub fn inner_distance_px(positions: &[V2], reference: &[V2], pixel_size: f64) -> f64 {
+    let n = positions.len();
+    positions[1..n - 1]
+        .iter()
+        .zip(&reference[1..n - 1])
+        .map(|(p, q)| (p - q).norm())
+        .sum::<f64>()
+        / (n - 2) as f64
+        / pixel_size
+}
+
+/// Mean over `r` of the distance from the noise-free markers `truth` (shape index → markers,
+/// metres), px; `None` when any shape has no equilibrium.
+pub fn mean_error_from_truth(r: &[Reproduced], truth: &[Vec<V2>], pixel_size: f64) -> Option<f64> {
+    let e: Option<Vec<f64>> = r
+        .iter()
+        .map(|x| {
+            (!x.positions.is_empty())
+                .then(|| inner_distance_px(&x.positions, &truth[x.shape], pixel_size))
+        })
+        .collect();
+    e.filter(|v| !v.is_empty())
+        .map(|v| v.iter().sum::<f64>() / v.len() as f64)
 }
 
 /// Mean of the errors that were measured; `None` when any shape has no equilibrium.
