@@ -9,6 +9,7 @@
 //! inner node is in equilibrium ([`identify`], Levenberg–Marquardt with an analytic Jacobian).
 //! [`string::StringModel::equilibrium`] then reproduces any shape for given end positions.
 
+pub mod cloth;
 pub mod error;
 pub mod experiment;
 pub mod identify;

@@ -3,70 +3,12 @@
 //! chord from the platform edge to the tip makes 41.5° with the horizontal.
 
 use atelier_fabric::AnisotropyForm;
+use atelier_fit::cloth::elastica;
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
 use nalgebra::Vector3;
 
 use crate::common::fabric;
-
-/// The heavy inextensible elastica clamped at σ = 0, free at σ = 1:
-/// θ'' = −λ(1 − σ) cos θ, θ(0) = 0, θ'(1) = 0, solved by shooting on θ'(0) with RK4 on `n` steps.
-/// Returns the centreline (x, y)/L at the `n + 1` stations, y downwards.
-fn elastica(lambda: f64, n: usize) -> Vec<(f64, f64)> {
-    let h = 1.0 / n as f64;
-    let shoot = |k: f64, keep: bool| -> (f64, Vec<(f64, f64)>) {
-        let f = |s: f64, th: f64, w: f64| (w, -lambda * (1.0 - s) * th.cos());
-        let (mut th, mut w) = (0.0, k);
-        let mut pts = vec![(0.0, 0.0)];
-        let (mut x, mut y) = (0.0, 0.0);
-        for i in 0..n {
-            let s = i as f64 * h;
-            let (a1, b1) = f(s, th, w);
-            let (a2, b2) = f(s + h / 2.0, th + h / 2.0 * a1, w + h / 2.0 * b1);
-            let (a3, b3) = f(s + h / 2.0, th + h / 2.0 * a2, w + h / 2.0 * b2);
-            let (a4, b4) = f(s + h, th + h * a3, w + h * b3);
-            let th_new = th + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
-            w += h / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4);
-            if keep {
-                // Trapezoidal position update (the stations are fine enough for 1e-6).
-                x += 0.5 * h * (th.cos() + th_new.cos());
-                y += 0.5 * h * (th.sin() + th_new.sin());
-                pts.push((x, y));
-            }
-            th = th_new;
-        }
-        (w, pts)
-    };
-    let (mut lo, mut hi) = (0.0, lambda / 2.0);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if shoot(mid, false).0 > 0.0 {
-            hi = mid
-        } else {
-            lo = mid
-        }
-    }
-    shoot(0.5 * (lo + hi), true).1
-}
-
-/// The elastica itself reproduces the reference numbers: λ = 8.0042 gives the 41.5° chord and
-/// the tip at (0.7243, 0.6408)·L.
-#[test]
-fn the_reference_elastica_reproduces_the_published_numbers() {
-    let pts = elastica(8.00420, 4000);
-    let (x, y) = pts[pts.len() - 1];
-    assert!(
-        (y.atan2(x).to_degrees() - 41.5).abs() < 1e-3,
-        "{}",
-        y.atan2(x).to_degrees()
-    );
-    assert!(
-        (x - 0.7243).abs() < 1e-4 && (y - 0.6408).abs() < 1e-4,
-        "({x}, {y})"
-    );
-    let small = elastica(0.01, 2000);
-    assert!((small[small.len() - 1].1 - 0.01 / 8.0).abs() < 1e-6);
-}
 
 /// One simulated cantilever: a strip of `segments` cells along the warp, two nodes wide (1 cm),
 /// clamped by two rows of pinned nodes at ±h/2 about the platform edge x = 0 (the discrete slope
