@@ -232,3 +232,188 @@ pub fn simulate(spec: &StringFitSpec, base: &Path) -> Result<Simulated, RunError
         comparison: None,
     })
 }
+
+// ------------------------------------------------------------------------------------------
+// Cloth: `atelier fit OBSERVATIONS.ron` (docs/fit.md, "Carried over to cloth").
+
+/// One observed cantilever profile of a fabric strip.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CantileverObservation {
+    /// Along which direction the strip was cut.
+    pub direction: crate::scenario::StripDirection,
+    /// Overhang L beyond the platform edge, m.
+    pub overhang: f64,
+    /// The centreline's points `(s, x, droop)`: arc length from the edge, distance forward,
+    /// droop below the edge, m.
+    pub points: Vec<(f64, f64, f64)>,
+}
+
+/// Observations of a fabric to fit (RON struct name `ClothObservations`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "ClothObservations", deny_unknown_fields)]
+pub struct ClothObservations {
+    /// What was observed.
+    pub name: String,
+    /// Where the observations come from.
+    pub provenance: String,
+    /// The fabric file whose other values are kept (its mass per area gives w), relative to
+    /// the observation file.
+    pub base: PathBuf,
+    /// Cantilever profiles, at most one per direction.
+    pub cantilevers: Vec<CantileverObservation>,
+}
+
+/// The fit of one direction.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DirectionFit {
+    /// `Warp` or `Weft`.
+    pub direction: String,
+    /// Bending rigidity fitted, N·m (and in KES units, gf·cm²/cm).
+    pub b_n_m: f64,
+    /// The same in gf·cm²/cm.
+    pub b_gf_cm2_cm: f64,
+    /// The base fabric's, gf·cm²/cm.
+    pub base_b_gf_cm2_cm: f64,
+    /// Bending length c = (B/w)^(1/3), m.
+    pub bending_length_m: f64,
+    /// λ = wL³/B of the fitted elastica.
+    pub lambda: f64,
+    /// RMS distance of the points from the fitted elastica, m.
+    pub rms_m: f64,
+    /// Points used.
+    pub points: usize,
+}
+
+/// What `atelier fit` writes as `fit_report.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClothFitReport {
+    /// `atelier-cloth-fit/1`.
+    pub format: String,
+    /// The observations' name.
+    pub name: String,
+    /// The observation file.
+    pub observations: PathBuf,
+    /// The base fabric file.
+    pub base: PathBuf,
+    /// Per direction.
+    pub fits: Vec<DirectionFit>,
+    /// The files written beside it.
+    pub outputs: Vec<String>,
+}
+
+/// Fit the bending rigidity per direction of the cantilever profiles in `observations` and
+/// write `fabric.ron` (the base fabric with those B) and `fit_report.json` into `out`. Every
+/// file is written under a temporary name and renamed; nothing is written when the fit fails.
+pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunError> {
+    use atelier_fabric::spec::{BendingSpec, FabricSpec};
+    use atelier_fabric::{ErrorKind, FileError, InvalidValue, files};
+    use atelier_fit::cloth::{ProfilePoint, fit_cantilever};
+    let setup = |e: String| RunError::Setup(e);
+    let text = files::read_text(observations).map_err(|e| setup(e.to_string()))?;
+    let obs: ClothObservations =
+        files::parse_ron(&text, observations).map_err(|e| setup(e.to_string()))?;
+    let located = |field: String, message: String| -> RunError {
+        let e: FileError = files::located(
+            observations,
+            &text,
+            InvalidValue::new(ErrorKind::OutOfRange, field, message),
+        );
+        setup(e.to_string())
+    };
+    if obs.cantilevers.is_empty() {
+        return Err(located("cantilevers".into(), "no profile".into()));
+    }
+    let base_path = observations
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join(&obs.base);
+    let mut spec: FabricSpec = files::load_ron(&base_path).map_err(|e| setup(e.to_string()))?;
+    let base = atelier_fabric::Fabric::from_spec(&spec)
+        .map_err(|e| setup(FileError::from_invalid(&base_path, e).to_string()))?;
+    let w = base.weight_per_area();
+    let mut fits = Vec::new();
+    let mut seen = Vec::new();
+    for (k, c) in obs.cantilevers.iter().enumerate() {
+        let name = format!("{:?}", c.direction);
+        if seen.contains(&name) {
+            return Err(located(
+                format!("cantilevers[{k}].direction"),
+                format!("a second {name} profile"),
+            ));
+        }
+        seen.push(name.clone());
+        let points: Vec<ProfilePoint> = c
+            .points
+            .iter()
+            .map(|&(s, x, droop)| ProfilePoint { s, x, droop })
+            .collect();
+        let fit = fit_cantilever(&points, c.overhang)
+            .map_err(|e| located(format!("cantilevers[{k}]"), e.to_string()))?;
+        let b = w * fit.bending_length.powi(3);
+        let b_kes = b / atelier_fabric::units::BENDING_RIGIDITY;
+        let slot = match c.direction {
+            crate::scenario::StripDirection::Warp => &mut spec.bending.warp,
+            crate::scenario::StripDirection::Weft => &mut spec.bending.weft,
+        };
+        let BendingSpec::Kes(kes) = slot else {
+            return Err(setup(format!(
+                "{}: the base fabric's {name} bending is a measured loop; `atelier fit` replaces KES values only",
+                base_path.display()
+            )));
+        };
+        let base_b = kes.b_gf_cm2_cm;
+        kes.b_gf_cm2_cm = b_kes;
+        fits.push(DirectionFit {
+            direction: name,
+            b_n_m: b,
+            b_gf_cm2_cm: b_kes,
+            base_b_gf_cm2_cm: base_b,
+            bending_length_m: fit.bending_length,
+            lambda: fit.lambda,
+            rms_m: fit.rms,
+            points: points.len(),
+        });
+    }
+    spec.name = format!("{} (B fitted to {})", spec.name, obs.name);
+    spec.provenance.notes = format!(
+        "{} Bending rigidity B of {} fitted by `atelier fit` to the cantilever profiles of {} ({}); 2HB and every other value as in {}.",
+        spec.provenance.notes,
+        fits.iter()
+            .map(|f| f.direction.to_lowercase())
+            .collect::<Vec<_>>()
+            .join(" and "),
+        observations.display(),
+        obs.provenance,
+        obs.base.display()
+    );
+    let pretty = ron::ser::PrettyConfig::new().depth_limit(4).extensions(
+        ron::extensions::Extensions::IMPLICIT_SOME
+            | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES,
+    );
+    let fabric_text = ron::ser::to_string_pretty(&spec, pretty)
+        .map_err(|e| setup(format!("writing the fabric: {e}")))?;
+    // The written file must read back as a fabric.
+    atelier_fabric::Fabric::from_ron_str(&fabric_text, Path::new("fabric.ron"))
+        .map_err(|e| setup(format!("the fitted fabric does not read back: {e}")))?;
+    std::fs::create_dir_all(out).map_err(|source| RunError::Output {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let io = |path: PathBuf| move |source| RunError::Output { path, source };
+    let path = out.join("fabric.ron");
+    files::write_atomic(&path, fabric_text.as_bytes()).map_err(io(path))?;
+    let report = ClothFitReport {
+        format: "atelier-cloth-fit/1".into(),
+        name: obs.name.clone(),
+        observations: observations.to_path_buf(),
+        base: base_path,
+        fits,
+        outputs: vec!["fabric.ron".into(), "fit_report.json".into()],
+    };
+    let json = serde_json::to_string_pretty(&report)
+        .map_err(|e| setup(format!("writing the report: {e}")))?;
+    let path = out.join("fit_report.json");
+    files::write_atomic(&path, json.as_bytes()).map_err(io(path))?;
+    Ok(report)
+}

@@ -118,3 +118,79 @@ fn bending_rigidity_is_recovered_from_cantilever_profiles() {
         }
     }
 }
+
+/// `atelier fit` (the library call behind it): cotton broad's simulated warp and weft profiles
+/// written as a `ClothObservations` file against the fixture as base; the fabric.ron it writes
+/// reads back with both B within 6 % of cotton broad's and its 2HB untouched, fit_report.json
+/// lists both directions; a second profile of one direction is refused with its position, and
+/// nothing is written then.
+#[test]
+fn atelier_fit_writes_a_fabric_with_the_fitted_rigidity() {
+    let dir = std::env::temp_dir().join(format!("atelier-fit-cloth-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let base = root().join("fixtures/fabrics/cotton_broad.ron");
+    let cotton = Fabric::load(&base).expect("fabric");
+    let mut entries = Vec::new();
+    for direction in ["Warp", "Weft"] {
+        let (points, length) = profile("cotton_broad", direction);
+        let pts: Vec<String> = points
+            .iter()
+            .map(|p| format!("({}, {}, {})", p.s, p.x, p.droop))
+            .collect();
+        entries.push(format!(
+            "(direction: {direction}, overhang: {length}, points: [{}])",
+            pts.join(", ")
+        ));
+    }
+    let observations = |cantilevers: &str| {
+        format!(
+            r#"ClothObservations(
+    name: "cotton strips",
+    provenance: "the PARTY solver's cantilevers of cotton broad (test)",
+    base: "{}",
+    cantilevers: [{cantilevers}],
+)"#,
+            base.display()
+        )
+    };
+    let file = dir.join("obs.ron");
+    std::fs::write(&file, observations(&entries.join(", "))).expect("write");
+    let out = dir.join("out");
+    let report = atelier::fit::fit_cloth(&file, &out).expect("fits");
+    assert_eq!(report.fits.len(), 2);
+    let fitted = Fabric::load(&out.join("fabric.ron")).expect("the fitted fabric reads back");
+    for (got, want) in [
+        (
+            fitted.bending.warp.rigidity(),
+            cotton.bending.warp.rigidity(),
+        ),
+        (
+            fitted.bending.weft.rigidity(),
+            cotton.bending.weft.rigidity(),
+        ),
+    ] {
+        assert!((got / want - 1.0).abs() < 0.06, "{got} vs {want}");
+    }
+    let m0 = |f: &Fabric| f.bending.warp.residual_moment();
+    assert!(
+        (m0(&fitted) / m0(&cotton) - 1.0).abs() < 1e-12,
+        "2HB changed"
+    );
+    assert!(out.join("fit_report.json").is_file());
+    // Two warp profiles: refused, naming the second, nothing written.
+    let bad = dir.join("bad.ron");
+    std::fs::write(
+        &bad,
+        observations(&format!("{}, {}", entries[0], entries[0])),
+    )
+    .expect("write");
+    let e = atelier::fit::fit_cloth(&bad, &dir.join("bad_out")).expect_err("refused");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("cantilevers[1].direction") && msg.contains("bad.ron:"),
+        "{msg}"
+    );
+    assert!(!dir.join("bad_out").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -51,6 +51,15 @@ enum Command {
         #[command(flatten)]
         options: Options,
     },
+    /// Fit a fabric's bending rigidity per direction to observed cantilever profiles
+    /// (`ClothObservations` RON, docs/fit.md): writes fabric.ron and fit_report.json in DIR.
+    Fit {
+        /// Observation file (RON).
+        observations: PathBuf,
+        /// Output folder (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
     /// Check fabric, pattern, garment, body, motion, range side and scenario files (RON) and
     /// body meshes (OBJ, PLY); print each problem with file:line:column and field.
     Validate {
@@ -108,6 +117,34 @@ fn main() -> ExitCode {
             }
         },
         Some(Command::Validate { files }) => validate(&files),
+        Some(Command::Fit { observations, out }) => {
+            match atelier::fit::fit_cloth(&observations, &out) {
+                Ok(report) => {
+                    // The fitted values are the program's output.
+                    #[allow(clippy::print_stdout)]
+                    {
+                        for f in &report.fits {
+                            println!(
+                                "{}: B = {:.4} gf·cm²/cm ({:.4e} N·m; base {:.4}), c = {:.2} cm, RMS {:.3} mm over {} points",
+                                f.direction,
+                                f.b_gf_cm2_cm,
+                                f.b_n_m,
+                                f.base_b_gf_cm2_cm,
+                                f.bending_length_m * 100.0,
+                                f.rms_m * 1e3,
+                                f.points
+                            );
+                        }
+                        println!("wrote {}", out.join("fabric.ron").display());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("atelier: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
     }
 }
 
