@@ -450,3 +450,73 @@ fn with_no_arguments_the_default_scenario_runs_from_any_folder() {
     assert!(dir.join("atelier-out/final.png").is_file());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `atelier fit`: a warp profile sampled from the elastica of cotton broad's own bending length
+/// gives back its B (0.118 gf·cm²/cm, printed to four digits) and writes fabric.ron and
+/// fit_report.json; a point beyond the overhang fails with exit status 1, the file, the field
+/// and nothing written.
+#[test]
+fn atelier_fit_prints_the_fitted_rigidity_and_refuses_a_bad_profile() {
+    let dir = std::env::temp_dir().join(format!("atelier-cli-fit-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let base = root().join("fixtures/fabrics/cotton_broad.ron");
+    let f = atelier_fabric::Fabric::load(&base).expect("fabric");
+    let c = (f.bending.warp.rigidity() / f.weight_per_area()).cbrt();
+    let length = 2.0003 * c;
+    let lambda = (length / c).powi(3);
+    let e = atelier_fit::cloth::elastica(lambda, 2000);
+    let points: Vec<String> = (1..=20)
+        .map(|k| {
+            let (x, y) = e[k * 100];
+            format!(
+                "({}, {}, {})",
+                k as f64 * length / 20.0,
+                x * length,
+                y * length
+            )
+        })
+        .collect();
+    let write = |name: &str, pts: &str| {
+        let path = dir.join(name);
+        std::fs::write(
+            &path,
+            format!(
+                r#"ClothObservations(name: "t", provenance: "elastica (test)", base: "{}",
+  cantilevers: [(direction: Warp, overhang: {length}, points: [{pts}])])"#,
+                base.display()
+            ),
+        )
+        .expect("write");
+        path
+    };
+    let good = write("good.ron", &points.join(", "));
+    let out = dir.join("out");
+    let (ok, stdout, err) = atelier(&[
+        "fit",
+        good.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert!(ok, "{stdout}{err}");
+    assert!(stdout.contains("Warp: B = 0.1180 gf·cm²/cm"), "{stdout}");
+    assert!(out.join("fabric.ron").is_file() && out.join("fit_report.json").is_file());
+    let bad = write(
+        "bad.ron",
+        &format!("{}, ({}, 0.0, 0.0)", points.join(", "), 2.0 * length),
+    );
+    let bad_out = dir.join("bad_out");
+    let (ok, _, err) = atelier(&[
+        "fit",
+        bad.to_str().expect("utf-8"),
+        "--out",
+        bad_out.to_str().expect("utf-8"),
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("bad.ron") && err.contains("cantilevers[0]"),
+        "{err}"
+    );
+    assert!(!bad_out.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
