@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use atelier::scenario::Scenario;
 use atelier_fabric::Fabric;
+use atelier_fabric::noise::Rng;
 use atelier_fit::cloth::{ProfilePoint, fit_cantilever};
-use atelier_fit::synthetic::Noise;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -90,7 +90,7 @@ fn bending_rigidity_is_recovered_from_cantilever_profiles() {
                 // Mean |error| over 10 noise draws.
                 let mut errors = Vec::new();
                 for seed in 0..10 {
-                    let mut noise = Noise::new(100 * k as u64 + seed);
+                    let mut noise = Rng::new(100 * k as u64 + seed);
                     let noisy: Vec<ProfilePoint> = points
                         .iter()
                         .map(|p| ProfilePoint {

@@ -31,6 +31,7 @@ pub mod error;
 pub mod fabric;
 pub mod files;
 pub(crate) mod interp;
+pub mod noise;
 pub mod plausibility;
 pub mod spec;
 pub mod tensile;

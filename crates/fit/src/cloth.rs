@@ -157,7 +157,7 @@ pub fn fit_cantilever(points: &[ProfilePoint], length: f64) -> Result<Cantilever
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synthetic::Noise;
+    use atelier_fabric::noise::Rng;
 
     /// The elastica reproduces the reference numbers (`reference/elastica.md`): λ = 8.0042 gives
     /// the 41.5° chord with the tip at (0.7243, 0.6408)·L; small deflection y/L = λ/8.
@@ -192,7 +192,7 @@ mod tests {
             .collect();
         let exact = fit_cantilever(&points, length).expect("fit");
         assert!((exact.lambda / lambda - 1.0).abs() < 1e-5, "{exact:?}");
-        let mut noise = Noise::new(3);
+        let mut noise = Rng::new(3);
         let noisy: Vec<ProfilePoint> = points
             .iter()
             .map(|p| ProfilePoint {

@@ -18,6 +18,8 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
+use atelier_fabric::noise::Rng;
+
 use crate::FitError;
 use crate::observation::{Observations, ObservedShape};
 use crate::rod::{Rod, RodSpec};
@@ -142,31 +144,6 @@ impl Default for SyntheticOptions {
     }
 }
 
-/// SplitMix64 with Box–Muller normals: a reproducible seeded stream (ten lines, not a crate).
-pub struct Noise(u64);
-
-impl Noise {
-    /// The stream of `seed`.
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        (z ^ (z >> 31)) as f64 / 2f64.powi(64)
-    }
-
-    /// Standard normal.
-    pub fn normal(&mut self) -> f64 {
-        let (u1, u2) = (1.0 - self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
-    }
-}
-
 /// A start shape between `a` and `b` for a chain of `n` particles and rest length `length`: a
 /// sine sag below the chord whose arc length is `length` (the chord when shorter).
 pub fn sag_start(a: V2, b: V2, n: usize, length: f64) -> Vec<V2> {
@@ -236,7 +213,7 @@ pub fn observe(
         shapes: Vec::new(),
     };
     let fixed = obs.to_metres(o.fixed_end);
-    let mut noise = Noise::new(o.seed);
+    let mut noise = Rng::new(o.seed);
     let mut truth = Vec::new();
     let step = o.segments / (o.markers - 1);
     // Stratified angles in a seeded order, so that any first J shapes spread over the range
@@ -284,7 +261,7 @@ mod tests {
     /// The noise has the asked σ and no bias (10 000 draws: mean within 0.03, σ within 3 %).
     #[test]
     fn the_noise_is_standard_normal() {
-        let mut n = Noise::new(7);
+        let mut n = Rng::new(7);
         let x: Vec<f64> = (0..10_000).map(|_| n.normal()).collect();
         let mean = x.iter().sum::<f64>() / x.len() as f64;
         let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / x.len() as f64;

@@ -849,10 +849,7 @@ mod tests {
                     air,
                     ..PressureParams::default()
                 },
-                Surface::Plane {
-                    plane: Plane::horizontal(0.0),
-                    rest: 0.0,
-                },
+                plane_surface(),
             );
             let mut f = vec![V3::zeros(); p.len()];
             model.add_forces(&p, &t, &area, &boundary, 0.0, &mut f);
@@ -882,10 +879,7 @@ mod tests {
                     bubbles,
                     ..PressureParams::default()
                 },
-                Surface::Plane {
-                    plane: Plane::horizontal(0.0),
-                    rest: 0.0,
-                },
+                plane_surface(),
             );
             for k in 0..20 {
                 let lift = 0.002 + 0.038 * k as f64 / 19.0;
@@ -929,10 +923,7 @@ mod tests {
                 bubbles: Bubbles::Pockets { contact: 1e-4 },
                 ..PressureParams::default()
             },
-            Surface::Plane {
-                plane: Plane::horizontal(0.0),
-                rest: 0.0,
-            },
+            plane_surface(),
         );
         let mut f = vec![V3::zeros(); p.len()];
         model.add_forces(&p, &t, &area, &boundary, 0.0, &mut f);
@@ -966,10 +957,7 @@ mod tests {
                 leak: q,
                 ..PressureParams::default()
             },
-            Surface::Plane {
-                plane: Plane::horizontal(0.0),
-                rest: 0.0,
-            },
+            plane_surface(),
         );
         let mut f = vec![V3::zeros(); p.len()];
         let dt = 0.01;
