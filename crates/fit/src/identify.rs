@@ -201,15 +201,7 @@ impl Problem<'_> {
         self.particles() - 2
     }
 
-    /// The model with the parameters of `p`, and shape j's positions.
-    fn model(&self) -> StringModel {
-        let off = 2 * self.inner() * self.shapes.len();
-        StringModel {
-            params: decode(self.particles(), &self.p.as_slice()[off..]).0,
-            ..self.model.clone()
-        }
-    }
-
+    /// Shape j's positions: the markers' ends with the unknowns between them.
     fn positions(&self, j: usize) -> Vec<V2> {
         let (n, y) = (self.inner(), &self.shapes[j]);
         let mut x = y.clone();
@@ -269,6 +261,8 @@ impl Problem<'_> {
         (r, a, b)
     }
 
+    /// The model with the parameters of `p`, and each parameter's derivative by its encoded
+    /// value.
     fn decoded(&self) -> (StringModel, Vec<f64>) {
         let off = 2 * self.inner() * self.shapes.len();
         let (params, dq) = decode(self.particles(), &self.p.as_slice()[off..]);
@@ -343,7 +337,8 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 /// only with themselves and the parameters): the damped normal equations solved by the Schur
 /// complement on the parameters, so that an iteration costs J small solves and one of the
 /// parameters' size instead of a dense QR of the whole Jacobian. Marquardt's damping
-/// `λ·diag(JᵀJ)` with Nielsen's update. Returns (termination, iterations, evaluations,
+/// `λ·D` with D the largest diagonal of JᵀJ seen so far (MINPACK's scaling) and Nielsen's
+/// update. Returns (termination, iterations, evaluations,
 /// converged).
 fn schur_lm(pr: &mut Problem, max_iterations: Option<usize>) -> (String, usize, usize, bool) {
     let (n, jn) = (2 * pr.inner(), pr.shapes.len());
@@ -351,7 +346,8 @@ fn schur_lm(pr: &mut Problem, max_iterations: Option<usize>) -> (String, usize, 
     let np = pr.p.len() - off;
     let mut cost = pr.cost();
     let mut evaluations = 1;
-    let (mut lambda, mut nu) = (-1.0, 2.0);
+    let (mut lambda, mut nu) = (1e-3, 2.0);
+    let (mut scale_u, mut scale_q): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
     let mut iterations = 0;
     loop {
         if max_iterations.is_some_and(|m| iterations >= m) {
@@ -373,30 +369,37 @@ fn schur_lm(pr: &mut Problem, max_iterations: Option<usize>) -> (String, usize, 
             v += b.transpose() * b;
             gq += b.transpose() * r;
         }
-        if lambda < 0.0 {
-            let dmax = us
-                .iter()
-                .flat_map(|u| u.0.diagonal().iter().copied().collect::<Vec<_>>())
-                .chain(v.diagonal().iter().copied())
-                .fold(0.0, f64::max);
-            lambda = 1e-3 * dmax;
+        // MINPACK's scaling: each unknown damped by the largest diagonal of JᵀJ it has had,
+        // so that a direction once stiff stays damped as stiff (λ dimensionless).
+        if scale_u.is_empty() {
+            scale_u = vec![0.0; off];
+            scale_q = vec![0.0; np];
+            lambda = 1e-3;
+        }
+        for (j, u) in us.iter().enumerate() {
+            for i in 0..n {
+                scale_u[n * j + i] = scale_u[n * j + i].max(u.0[(i, i)]).max(1e-12);
+            }
+        }
+        for i in 0..np {
+            scale_q[i] = scale_q[i].max(v[(i, i)]).max(1e-12);
         }
         let mut accepted = false;
         while !accepted {
             // Damped blocks, their inverses applied through Cholesky.
-            let damp = |m: &DMatrix<f64>| {
+            let damp = |m: &DMatrix<f64>, scale: &[f64]| {
                 let mut d = m.clone();
                 for i in 0..d.nrows() {
-                    d[(i, i)] += lambda * m[(i, i)].max(1e-12);
+                    d[(i, i)] += lambda * scale[i];
                 }
                 d
             };
-            let mut s = damp(&v);
+            let mut s = damp(&v, &scale_q);
             let mut rhs = -gq.clone();
             let mut chol = Vec::with_capacity(jn);
             let mut ok = true;
-            for (u, w, g) in &us {
-                let Some(c) = damp(u).cholesky() else {
+            for (j, (u, w, g)) in us.iter().enumerate() {
+                let Some(c) = damp(u, &scale_u[n * j..n * (j + 1)]).cholesky() else {
                     ok = false;
                     break;
                 };
@@ -561,7 +564,7 @@ pub fn identify(
     };
     let positions = (0..shapes.len()).map(|j| problem.positions(j)).collect();
     Ok(Fit {
-        model: problem.model(),
+        model: problem.decoded().0,
         positions,
         initial_cost,
         cost: problem.cost(),
