@@ -872,6 +872,17 @@ impl Solver {
         });
         // Linearised bending for the implicit solve: per slot W·B/2 where the direction has both
         // neighbours (the node moment counts only those), and the slot length.
+        // With hysteresis the curve after a turning point is steeper than B (up to the stick
+        // slope): linearising with B alone leaves (stick − 1)·B explicit, which alternates
+        // step by step on fine grids (`implicit_stick_slope`).
+        let steepest = |sp: &atelier_fabric::Spindle| {
+            if params.implicit_stick_slope && hysteresis && sp.is_hysteretic() && stick.is_finite()
+            {
+                stick
+            } else {
+                1.0
+            }
+        };
         fill(&mut s.slot_coef, |i| {
             let mut coef = [0.0; SLOTS];
             for dir in 0..2 {
@@ -881,7 +892,8 @@ impl Solver {
                 }
                 for k in [k0, k1] {
                     let l = (pos[axial[i][k] as usize] - pos[i]).norm();
-                    coef[k] = 0.5 * (areas[i] / l) * table.bending(mats[i][k]).rigidity();
+                    let spindle = table.bending(mats[i][k]);
+                    coef[k] = 0.5 * (areas[i] / l) * spindle.rigidity() * steepest(spindle);
                 }
             }
             coef
