@@ -246,8 +246,24 @@ pub struct CantileverObservation {
     pub overhang: f64,
     /// The centreline's points `(s, x, droop)`: arc length from the edge, distance forward,
     /// droop below the edge, m.
-    pub points: Vec<(f64, f64, f64)>,
+    pub points: Vec<Point>,
 }
+
+/// One strip observed with its clamp turned downwards (docs/fit.md, bending hysteresis).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TurnedObservation {
+    /// Along which direction the strip was cut.
+    pub direction: crate::scenario::StripDirection,
+    /// Overhang L beyond the clamp's edge, m.
+    pub overhang: f64,
+    /// The profiles at increasing clamp angles: `(clamp_deg, points)`, points `(s, x, droop)`
+    /// in the fixed frame (x forward, droop downwards from the clamp's edge), m.
+    pub profiles: Vec<(f64, Vec<Point>)>,
+}
+
+/// An observed centreline point `(s, x, droop)`, m.
+pub type Point = (f64, f64, f64);
 
 /// Observations of a fabric to fit (RON struct name `ClothObservations`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -260,8 +276,12 @@ pub struct ClothObservations {
     /// The fabric file whose other values are kept (its mass per area gives w), relative to
     /// the observation file.
     pub base: PathBuf,
-    /// Cantilever profiles, at most one per direction.
+    /// Cantilever profiles (B), at most one observation per direction in both lists.
+    #[serde(default)]
     pub cantilevers: Vec<CantileverObservation>,
+    /// Turned-strip profiles (B and 2HB).
+    #[serde(default)]
+    pub turned: Vec<TurnedObservation>,
 }
 
 /// The fit of one direction.
@@ -283,6 +303,14 @@ pub struct DirectionFit {
     pub rms_m: f64,
     /// Points used.
     pub points: usize,
+    /// `cantilever` (the elastica: B) or `turned` (the spindle strip: B and 2HB).
+    pub observation: String,
+    /// Hysteresis 2HB fitted, gf·cm/cm (turned strips only).
+    pub two_hb_gf_cm_cm: Option<f64>,
+    /// The base fabric's 2HB, gf·cm/cm (turned strips only).
+    pub base_two_hb_gf_cm_cm: Option<f64>,
+    /// RMS of the best elastic strip to the same profiles, m (turned strips only).
+    pub elastic_rms_m: Option<f64>,
 }
 
 /// What `atelier fit` writes as `fit_report.json`.
@@ -307,9 +335,17 @@ pub struct ClothFitReport {
 /// file is written under a temporary name and renamed; nothing is written when the fit fails.
 pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunError> {
     use atelier_fabric::spec::{BendingSpec, FabricSpec};
+    use atelier_fabric::units;
     use atelier_fabric::{ErrorKind, FileError, InvalidValue, files};
     use atelier_fit::cloth::{ProfilePoint, fit_cantilever};
+    use atelier_fit::turned::{TurnedProfile, fit_turned};
     let setup = |e: String| RunError::Setup(e);
+    let profile = |points: &[Point]| -> Vec<ProfilePoint> {
+        points
+            .iter()
+            .map(|&(s, x, droop)| ProfilePoint { s, x, droop })
+            .collect()
+    };
     let text = files::read_text(observations).map_err(|e| setup(e.to_string()))?;
     let obs: ClothObservations =
         files::parse_ron(&text, observations).map_err(|e| setup(e.to_string()))?;
@@ -321,7 +357,7 @@ pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunE
         );
         setup(e.to_string())
     };
-    if obs.cantilevers.is_empty() {
+    if obs.cantilevers.is_empty() && obs.turned.is_empty() {
         return Err(located("cantilevers".into(), "no profile".into()));
     }
     let base_path = observations
@@ -332,27 +368,60 @@ pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunE
     let base = atelier_fabric::Fabric::from_spec(&spec)
         .map_err(|e| setup(FileError::from_invalid(&base_path, e).to_string()))?;
     let w = base.weight_per_area();
-    let mut fits = Vec::new();
-    let mut seen = Vec::new();
+    // Every observation fitted first: (direction, field, B, Some(M₀) for turned, fit record).
+    let mut fitted = Vec::new();
     for (k, c) in obs.cantilevers.iter().enumerate() {
-        let name = format!("{:?}", c.direction);
-        if seen.contains(&name) {
-            return Err(located(
-                format!("cantilevers[{k}].direction"),
-                format!("a second {name} profile"),
-            ));
-        }
-        seen.push(name.clone());
-        let points: Vec<ProfilePoint> = c
-            .points
-            .iter()
-            .map(|&(s, x, droop)| ProfilePoint { s, x, droop })
-            .collect();
-        let fit = fit_cantilever(&points, c.overhang)
+        let fit = fit_cantilever(&profile(&c.points), c.overhang)
             .map_err(|e| located(format!("cantilevers[{k}]"), e.to_string()))?;
         let b = w * fit.bending_length.powi(3);
-        let b_kes = b / atelier_fabric::units::BENDING_RIGIDITY;
-        let slot = match c.direction {
+        let record = (
+            fit.lambda,
+            fit.bending_length,
+            fit.rms,
+            None,
+            c.points.len(),
+        );
+        fitted.push((c.direction, format!("cantilevers[{k}]"), b, None, record));
+    }
+    for (k, t) in obs.turned.iter().enumerate() {
+        let profiles: Vec<TurnedProfile> = t
+            .profiles
+            .iter()
+            .map(|(clamp_deg, points)| TurnedProfile {
+                clamp_deg: *clamp_deg,
+                points: profile(points),
+            })
+            .collect();
+        let fit = fit_turned(&profiles, t.overhang, w)
+            .map_err(|e| located(format!("turned[{k}]"), e.to_string()))?;
+        let b = fit.rigidity;
+        let c = (b / w).cbrt();
+        let n = t.profiles.iter().map(|p| p.1.len()).sum();
+        let record = (
+            w * t.overhang.powi(3) / b,
+            c,
+            fit.rms,
+            Some(fit.elastic_rms),
+            n,
+        );
+        fitted.push((
+            t.direction,
+            format!("turned[{k}]"),
+            b,
+            Some(fit.residual_moment),
+            record,
+        ));
+    }
+    let mut fits: Vec<DirectionFit> = Vec::new();
+    for (direction, field, b, m0, (lambda, c, rms, elastic_rms, points)) in fitted {
+        let name = format!("{direction:?}");
+        if fits.iter().any(|f| f.direction == name) {
+            return Err(located(
+                format!("{field}.direction"),
+                format!("a second {name} observation"),
+            ));
+        }
+        let slot = match direction {
             crate::scenario::StripDirection::Warp => &mut spec.bending.warp,
             crate::scenario::StripDirection::Weft => &mut spec.bending.weft,
         };
@@ -362,27 +431,43 @@ pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunE
                 base_path.display()
             )));
         };
-        let base_b = kes.b_gf_cm2_cm;
-        kes.b_gf_cm2_cm = b_kes;
+        let (base_b, base_two_hb) = (kes.b_gf_cm2_cm, kes.two_hb_gf_cm_cm);
+        kes.b_gf_cm2_cm = b / units::BENDING_RIGIDITY;
+        let two_hb = m0.map(|m0| 2.0 * m0 / units::BENDING_MOMENT);
+        if let Some(h) = two_hb {
+            kes.two_hb_gf_cm_cm = h;
+        }
         fits.push(DirectionFit {
             direction: name,
             b_n_m: b,
-            b_gf_cm2_cm: b_kes,
+            b_gf_cm2_cm: b / units::BENDING_RIGIDITY,
             base_b_gf_cm2_cm: base_b,
-            bending_length_m: fit.bending_length,
-            lambda: fit.lambda,
-            rms_m: fit.rms,
-            points: points.len(),
+            bending_length_m: c,
+            lambda,
+            rms_m: rms,
+            points,
+            observation: if m0.is_some() { "turned" } else { "cantilever" }.into(),
+            two_hb_gf_cm_cm: two_hb,
+            base_two_hb_gf_cm_cm: m0.map(|_| base_two_hb),
+            elastic_rms_m: elastic_rms,
         });
     }
-    spec.name = format!("{} (B fitted to {})", spec.name, obs.name);
+    spec.name = format!("{} (fitted to {})", spec.name, obs.name);
     spec.provenance.notes = format!(
-        "{} Bending rigidity B of {} fitted by `atelier fit` to the cantilever profiles of {} ({}); 2HB and every other value as in {}.",
+        "{} Fitted by `atelier fit`: {} to the profiles of {} ({}); every other value as in {}.",
         spec.provenance.notes,
         fits.iter()
-            .map(|f| f.direction.to_lowercase())
+            .map(|f| format!(
+                "{} {}",
+                f.direction.to_lowercase(),
+                if f.two_hb_gf_cm_cm.is_some() {
+                    "B and 2HB (turned strip)"
+                } else {
+                    "B (cantilever)"
+                }
+            ))
             .collect::<Vec<_>>()
-            .join(" and "),
+            .join(", "),
         observations.display(),
         obs.provenance,
         obs.base.display()

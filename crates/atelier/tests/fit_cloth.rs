@@ -6,9 +6,14 @@
 use std::path::PathBuf;
 
 use atelier::scenario::Scenario;
+use atelier_fabric::AnisotropyForm;
 use atelier_fabric::Fabric;
 use atelier_fabric::noise::Rng;
 use atelier_fit::cloth::{ProfilePoint, fit_cantilever};
+use atelier_fit::turned::{TurnedProfile, fit_turned};
+use atelier_grid::{ClothTopology, StructuredGrid};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+use nalgebra::Vector3;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -189,6 +194,272 @@ fn atelier_fit_writes_a_fabric_with_the_fitted_rigidity() {
     let msg = e.to_string();
     assert!(
         msg.contains("cantilevers[1].direction") && msg.contains("bad.ron:"),
+        "{msg}"
+    );
+    assert!(!dir.join("bad_out").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The turned cantilever in the PARTY solver, hysteresis on: the strip of the Cantilever
+/// scenario (`segments` cells, overhang 2.0003·c, 1 cm wide, clamped by its first two rows)
+/// laid out straight, gravity applied over 1 s, then the clamp turned downwards about the
+/// platform edge at 45°/s, holding at each of `angles` until every node is slower than 1 mm/s;
+/// the centreline's free points in the fixed frame at each hold. The shape tolerance is
+/// 1e-8 m (the default 1e-6 m, at this Δt = 0.25·h, leaves the nodes jittering at cm/s).
+fn turned(
+    fabric: &Fabric,
+    weft: bool,
+    segments: usize,
+    angles: &[f64],
+) -> (Vec<TurnedProfile>, f64) {
+    let b = if weft {
+        fabric.bending.weft.rigidity()
+    } else {
+        fabric.bending.warp.rigidity()
+    };
+    let length = 2.0003 * (b / fabric.weight_per_area()).cbrt();
+    let h = length / (segments as f64 + 0.5);
+    let nv = segments + 2;
+    let mut grid = StructuredGrid::sheet(2, nv, 0.01, (nv - 1) as f64 * h);
+    if weft {
+        grid.grain_angle = 0.0;
+    }
+    let topo = ClothTopology::from_structured(&grid).expect("grid");
+    let mut cloth = Cloth::new(topo, fabric, AnisotropyForm::Thesis).expect("cloth");
+    let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
+    let rest = cloth.topology().rest_positions().to_vec();
+    let clamp = |cloth: &mut Cloth, beta: f64| {
+        for (node, &r) in rest.iter().enumerate().take(4) {
+            let p = place(r);
+            let q = Vector3::new(p.x * beta.cos(), p.y, -p.x * beta.sin());
+            cloth.pin(node as u32, q, PinMotion::Fixed).expect("pin");
+        }
+    };
+    clamp(&mut cloth, 0.0);
+    let mut state = ClothState::placed(&cloth, place);
+    let mut params = StepParams {
+        dt: 0.25 * h,
+        damping: 5.0,
+        shape_tolerance: 1e-8,
+        implicit_stick_slope: true,
+        ..StepParams::default()
+    };
+    let g = params.gravity;
+    let mut solver = Solver::new();
+    let rate = 45f64.to_radians();
+    let mut beta = 0.0f64;
+    let mut profiles = Vec::new();
+    for &target in angles {
+        let target = target.to_radians();
+        let start = state.time;
+        loop {
+            let f = state.time.min(1.0);
+            params.gravity = g.map(|c| c * f);
+            if beta < target {
+                beta = (beta + rate * params.dt).min(target);
+                clamp(&mut cloth, beta);
+            }
+            solver.step(&cloth, &mut state, &params).expect("step");
+            let fastest = state
+                .velocities
+                .iter()
+                .map(|v| v.norm())
+                .fold(0.0, f64::max);
+            if f >= 1.0 && beta >= target && state.time - start > 0.5 && fastest < 1e-3 {
+                break;
+            }
+            assert!(state.time - start < 20.0, "not at rest: {fastest} m/s");
+        }
+        let points = (1..nv)
+            .map(|j| {
+                let p = (state.positions[2 * j] + state.positions[2 * j + 1]) * 0.5;
+                ProfilePoint {
+                    s: ((j as f64 - 0.5) * h).min(length),
+                    x: p.x,
+                    droop: -p.z,
+                }
+            })
+            .collect();
+        profiles.push(TurnedProfile {
+            clamp_deg: beta.to_degrees(),
+            points,
+        });
+    }
+    (profiles, length)
+}
+
+/// Bending rigidity and hysteresis together from the turned cantilever simulated by the
+/// solver (hysteresis on; B and 2HB hidden: only the overhang, the weight per area and the
+/// profiles at 0°, 45° and 90° are used), fitted with the quasi-static spindle strip
+/// (`atelier_fit::turned`). Measured (docs/fit.md): the hysteresis explains the turned
+/// profiles (RMS 3–6 times below the best elastic strip's), but the solver's discrete strip
+/// at 10–16 cells is not the continuum strip — B comes out high and M₀ low, by an amount that
+/// falls with refinement for wool (B +12 → +7 %, M₀ −37 → −22 % from 10 to 16 cells) and
+/// hardly for cotton broad, whose loop is the widest (B about +100 %). Asserted: for wool
+/// tropical at 16 cells B within 12 %, M₀ within 30 %, the hysteretic RMS a third of the
+/// elastic one or less; for every case M₀ > 0 found; with 0.2 mm of noise on every point the
+/// mean of five draws stays within the same bounds.
+#[test]
+fn bending_hysteresis_is_recovered_from_a_turned_cantilever() {
+    let angles = [0.0, 45.0, 90.0];
+    for (name, weft) in [
+        ("wool_tropical", false),
+        ("silk", false),
+        ("silk", true),
+        ("cotton_broad", false),
+    ] {
+        let f = Fabric::load(&root().join(format!("fixtures/fabrics/{name}.ron"))).expect("fabric");
+        let hidden = if weft { f.bending.weft } else { f.bending.warp };
+        let w = f.weight_per_area();
+        let errors = |fit: &atelier_fit::turned::HysteresisFit| {
+            (
+                fit.rigidity / hidden.rigidity() - 1.0,
+                fit.residual_moment / hidden.residual_moment() - 1.0,
+            )
+        };
+        for segments in [10, 16] {
+            let (profiles, length) = turned(&f, weft, segments, &angles);
+            let fit = fit_turned(&profiles, length, w).expect("fit");
+            let (eb, em) = errors(&fit);
+            let mut line = format!(
+                "{name} {} {segments} cells: B {:+.1} %, M0 {:+.1} %, RMS {:.3} mm (elastic {:.3} mm), set at 90° {:.2} mm, {} evaluations",
+                if weft { "weft" } else { "warp" },
+                100.0 * eb,
+                100.0 * em,
+                fit.rms * 1e3,
+                fit.elastic_rms * 1e3,
+                profiles[2].points.last().expect("points").x * 1e3,
+                fit.evaluations,
+            );
+            assert!(
+                fit.residual_moment > 0.05 * hidden.residual_moment(),
+                "{line}"
+            );
+            let wool = name == "wool_tropical" && segments == 16;
+            if wool {
+                assert!(eb.abs() < 0.12 && em.abs() < 0.30, "{line}");
+                assert!(fit.rms < fit.elastic_rms / 3.0, "{line}");
+                for sigma in [0.2e-3, 0.5e-3] {
+                    let mut draws = Vec::new();
+                    for seed in 0..5 {
+                        let mut noise = Rng::new(500 + seed);
+                        let noisy: Vec<TurnedProfile> = profiles
+                            .iter()
+                            .map(|p| TurnedProfile {
+                                points: p
+                                    .points
+                                    .iter()
+                                    .map(|q| ProfilePoint {
+                                        x: q.x + sigma * noise.normal(),
+                                        droop: q.droop + sigma * noise.normal(),
+                                        ..*q
+                                    })
+                                    .collect(),
+                                ..p.clone()
+                            })
+                            .collect();
+                        draws.push(errors(&fit_turned(&noisy, length, w).expect("fit")));
+                    }
+                    let n = draws.len() as f64;
+                    let mean = |k: usize| {
+                        draws
+                            .iter()
+                            .map(|d| if k == 0 { d.0 } else { d.1 })
+                            .sum::<f64>()
+                            / n
+                    };
+                    let spread = |k: usize| {
+                        let m = mean(k);
+                        (draws
+                            .iter()
+                            .map(|d| (if k == 0 { d.0 } else { d.1 } - m).powi(2))
+                            .sum::<f64>()
+                            / (n - 1.0))
+                            .sqrt()
+                    };
+                    line.push_str(&format!(
+                        "; σ {:.1} mm: B {:+.1} ± {:.1} %, M0 {:+.1} ± {:.1} %",
+                        sigma * 1e3,
+                        100.0 * mean(0),
+                        100.0 * spread(0),
+                        100.0 * mean(1),
+                        100.0 * spread(1)
+                    ));
+                    if sigma < 0.3e-3 {
+                        assert!(mean(0).abs() < 0.12 && mean(1).abs() < 0.30, "{line}");
+                    }
+                }
+            }
+            eprintln!("{line}");
+        }
+    }
+}
+
+/// `atelier fit` with a turned strip: the warp's B and 2HB replaced by the fitted values (the
+/// wool strip at 16 cells: within the bias measured above), the weft's kept; a turned strip
+/// observed at one angle only is refused as not identifiable, with its place, nothing written.
+#[test]
+fn atelier_fit_writes_the_fitted_hysteresis_of_a_turned_strip() {
+    let dir = std::env::temp_dir().join(format!("atelier-fit-turned-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let base = root().join("fixtures/fabrics/wool_tropical.ron");
+    let wool = Fabric::load(&base).expect("fabric");
+    let (profiles, length) = turned(&wool, false, 16, &[0.0, 45.0, 90.0]);
+    let text = |profiles: &[TurnedProfile]| {
+        let entries: Vec<String> = profiles
+            .iter()
+            .map(|p| {
+                let pts: Vec<String> = p
+                    .points
+                    .iter()
+                    .map(|q| format!("({}, {}, {})", q.s, q.x, q.droop))
+                    .collect();
+                format!("({}, [{}])", p.clamp_deg, pts.join(", "))
+            })
+            .collect();
+        format!(
+            r#"ClothObservations(
+    name: "wool turned strip",
+    provenance: "the PARTY solver's turned cantilever of wool tropical (test)",
+    base: "{}",
+    turned: [(direction: Warp, overhang: {length}, profiles: [{}])],
+)"#,
+            base.display(),
+            entries.join(", ")
+        )
+    };
+    let file = dir.join("obs.ron");
+    std::fs::write(&file, text(&profiles)).expect("write");
+    let out = dir.join("out");
+    let report = atelier::fit::fit_cloth(&file, &out).expect("fits");
+    assert_eq!(report.fits[0].observation, "turned");
+    let fitted = Fabric::load(&out.join("fabric.ron")).expect("the fitted fabric reads back");
+    let (got, want) = (fitted.bending.warp, wool.bending.warp);
+    assert!(
+        (got.rigidity() / want.rigidity() - 1.0).abs() < 0.12
+            && (got.residual_moment() / want.residual_moment() - 1.0).abs() < 0.30,
+        "B {} against {}, M0 {} against {}",
+        got.rigidity(),
+        want.rigidity(),
+        got.residual_moment(),
+        want.residual_moment()
+    );
+    assert_eq!(fitted.bending.weft, wool.bending.weft);
+    let bad = dir.join("bad.ron");
+    let one_angle: Vec<TurnedProfile> = profiles
+        .iter()
+        .take(2)
+        .map(|p| TurnedProfile {
+            clamp_deg: 0.0,
+            ..p.clone()
+        })
+        .collect();
+    std::fs::write(&bad, text(&one_angle)).expect("write");
+    let e = atelier::fit::fit_cloth(&bad, &dir.join("bad_out")).expect_err("refused");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("turned[0]") && msg.contains("not identifiable") && msg.contains("bad.ron:"),
         "{msg}"
     );
     assert!(!dir.join("bad_out").exists());

@@ -93,10 +93,9 @@ fn profile_rms(points: &[ProfilePoint], length: f64, lambda: f64) -> f64 {
     (sq / points.len() as f64).sqrt()
 }
 
-/// Fit the elastica to an observed centreline of a strip overhanging by `length`: golden-section
-/// search on ln λ over λ ∈ [0.01, 1000] (a strip drooping 0.1 % to 89 % of its length) to a
-/// relative precision of 1e-6.
-pub fn fit_cantilever(points: &[ProfilePoint], length: f64) -> Result<CantileverFit, FitError> {
+/// Refuse an overhang that is not finite and positive, a profile of fewer than two points, a
+/// non-finite point or an arc length outside [0, L].
+pub(crate) fn check_profile(points: &[ProfilePoint], length: f64) -> Result<(), FitError> {
     if !(length.is_finite() && length > 0.0) {
         return Err(FitError::invalid(
             "length",
@@ -126,6 +125,14 @@ pub fn fit_cantilever(points: &[ProfilePoint], length: f64) -> Result<Cantilever
             ));
         }
     }
+    Ok(())
+}
+
+/// Fit the elastica to an observed centreline of a strip overhanging by `length`: golden-section
+/// search on ln λ over λ ∈ [0.01, 1000] (a strip drooping 0.1 % to 89 % of its length) to a
+/// relative precision of 1e-6.
+pub fn fit_cantilever(points: &[ProfilePoint], length: f64) -> Result<CantileverFit, FitError> {
+    check_profile(points, length)?;
     let f = |ln: f64| profile_rms(points, length, ln.exp());
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut a, mut b) = (0.01f64.ln(), 1000f64.ln());

@@ -18,6 +18,7 @@ pub mod rod;
 pub mod statics;
 pub mod string;
 pub mod synthetic;
+pub mod turned;
 
 pub use error::FitError;
 pub use identify::{Fit, FitOptions, identify, initial_guess};

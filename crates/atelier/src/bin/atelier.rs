@@ -124,15 +124,22 @@ fn main() -> ExitCode {
                     #[allow(clippy::print_stdout)]
                     {
                         for f in &report.fits {
+                            let hysteresis = match (f.two_hb_gf_cm_cm, f.base_two_hb_gf_cm_cm) {
+                                (Some(h), Some(base)) => {
+                                    format!(", 2HB = {h:.4} gf·cm/cm (base {base:.4})")
+                                }
+                                _ => String::new(),
+                            };
                             println!(
-                                "{}: B = {:.4} gf·cm²/cm ({:.4e} N·m; base {:.4}), c = {:.2} cm, RMS {:.3} mm over {} points",
+                                "{}: B = {:.4} gf·cm²/cm ({:.4e} N·m; base {:.4}){hysteresis}, c = {:.2} cm, RMS {:.3} mm over {} points ({})",
                                 f.direction,
                                 f.b_gf_cm2_cm,
                                 f.b_n_m,
                                 f.base_b_gf_cm2_cm,
                                 f.bending_length_m * 100.0,
                                 f.rms_m * 1e3,
-                                f.points
+                                f.points,
+                                f.observation
                             );
                         }
                         println!("wrote {}", out.join("fabric.ron").display());
