@@ -10,6 +10,25 @@ use nalgebra::Vector3;
 
 use crate::common::fabric;
 
+/// The strip of `segments` cells along the warp, 1 cm wide, clamped by its first two rows at
+/// ±h/2 about the platform edge, straight: the cloth, its state, h and the nodes along it.
+fn strip(name: &str, length: f64, segments: usize) -> (Cloth, ClothState, f64, usize) {
+    let f = fabric(name);
+    let h = length / (segments as f64 + 0.5);
+    let nv = segments + 2;
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(2, nv, 0.01, (nv - 1) as f64 * h))
+            .expect("grid");
+    let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
+    let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
+    for node in 0..4 {
+        let p = place(cloth.topology().rest_positions()[node]);
+        cloth.pin(node as u32, p, PinMotion::Fixed).expect("pin");
+    }
+    let state = ClothState::placed(&cloth, place);
+    (cloth, state, h, nv)
+}
+
 /// One simulated cantilever: a strip of `segments` cells along the warp, two nodes wide (1 cm),
 /// clamped by two rows of pinned nodes at ±h/2 about the platform edge x = 0 (the discrete slope
 /// between them is zero exactly at the edge, which makes the clamp second order; clamping at
@@ -23,20 +42,7 @@ fn simulate(
     hysteresis: bool,
     damping: f64,
 ) -> (Vec<(f64, f64)>, f64) {
-    let f = fabric(name);
-    let h = length / (segments as f64 + 0.5);
-    let width = 0.01;
-    let nv = segments + 2;
-    let topo =
-        ClothTopology::from_structured(&StructuredGrid::sheet(2, nv, width, (nv - 1) as f64 * h))
-            .expect("grid");
-    let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
-    let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
-    for node in 0..4 {
-        let p = place(cloth.topology().rest_positions()[node]);
-        cloth.pin(node as u32, p, PinMotion::Fixed).expect("pin");
-    }
-    let mut state = ClothState::placed(&cloth, place);
+    let (cloth, mut state, h, nv) = strip(name, length, segments);
     // Implicit bending keeps this stable up to about 0.4·h s/m; 0.25·h leaves a margin.
     let dt = 0.25 * h;
     let params = StepParams {
@@ -141,18 +147,7 @@ fn a_hysteretic_strip_comes_to_rest() {
     let f = fabric("wool_tropical");
     let length = 2.0003 * (f.bending.warp.rigidity() / f.weight_per_area()).cbrt();
     let segments = 10;
-    let h = length / (segments as f64 + 0.5);
-    let nv = segments + 2;
-    let topo =
-        ClothTopology::from_structured(&StructuredGrid::sheet(2, nv, 0.01, (nv - 1) as f64 * h))
-            .expect("grid");
-    let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
-    let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
-    for node in 0..4 {
-        let p = place(cloth.topology().rest_positions()[node]);
-        cloth.pin(node as u32, p, PinMotion::Fixed).expect("pin");
-    }
-    let mut state = ClothState::placed(&cloth, place);
+    let (cloth, mut state, h, nv) = strip("wool_tropical", length, segments);
     let params = StepParams {
         dt: 0.25 * h,
         damping: 5.0,
