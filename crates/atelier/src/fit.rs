@@ -282,6 +282,11 @@ pub struct ClothObservations {
     /// Turned-strip profiles (B and 2HB).
     #[serde(default)]
     pub turned: Vec<TurnedObservation>,
+    /// Fit the turned strips' B and 2HB through the PARTY solver's own strip of this many
+    /// cells (`atelier::strip`), started from the continuum strip's fit: the values a PARTY run
+    /// at that resolution needs. None (default): the continuum strip only.
+    #[serde(default)]
+    pub solver_cells: Option<usize>,
 }
 
 /// The fit of one direction.
@@ -311,6 +316,9 @@ pub struct DirectionFit {
     pub base_two_hb_gf_cm_cm: Option<f64>,
     /// RMS of the best elastic strip to the same profiles, m (turned strips only).
     pub elastic_rms_m: Option<f64>,
+    /// The forward model: `elastica`, `spindle strip`, or `PARTY solver, N cells` (then the
+    /// RMS is the solver strip's).
+    pub forward_model: String,
 }
 
 /// What `atelier fit` writes as `fit_report.json`.
@@ -334,6 +342,7 @@ pub struct ClothFitReport {
 /// write `fabric.ron` (the base fabric with those B) and `fit_report.json` into `out`. Every
 /// file is written under a temporary name and renamed; nothing is written when the fit fails.
 pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunError> {
+    use crate::strip::{TurnedRun, fit_turned_party};
     use atelier_fabric::spec::{BendingSpec, FabricSpec};
     use atelier_fabric::units;
     use atelier_fabric::{ErrorKind, FileError, InvalidValue, files};
@@ -380,6 +389,7 @@ pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunE
             fit.rms,
             None,
             c.points.len(),
+            "elastica".to_string(),
         );
         fitted.push((c.direction, format!("cantilevers[{k}]"), b, None, record));
     }
@@ -394,26 +404,49 @@ pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunE
             .collect();
         let fit = fit_turned(&profiles, t.overhang, w)
             .map_err(|e| located(format!("turned[{k}]"), e.to_string()))?;
-        let b = fit.rigidity;
+        let (b, m0, rms, model) = match obs.solver_cells {
+            None => (
+                fit.rigidity,
+                fit.residual_moment,
+                fit.rms,
+                "spindle strip".to_string(),
+            ),
+            Some(segments) => {
+                let run = TurnedRun {
+                    segments,
+                    ..TurnedRun::default()
+                };
+                let party = fit_turned_party(
+                    &profiles,
+                    t.overhang,
+                    &base,
+                    t.direction,
+                    &run,
+                    (fit.rigidity, fit.residual_moment),
+                )
+                .map_err(|e| located(format!("turned[{k}]"), e.to_string()))?;
+                (
+                    party.rigidity,
+                    party.residual_moment,
+                    party.rms,
+                    format!("PARTY solver, {segments} cells"),
+                )
+            }
+        };
         let c = (b / w).cbrt();
         let n = t.profiles.iter().map(|p| p.1.len()).sum();
         let record = (
             w * t.overhang.powi(3) / b,
             c,
-            fit.rms,
+            rms,
             Some(fit.elastic_rms),
             n,
+            model,
         );
-        fitted.push((
-            t.direction,
-            format!("turned[{k}]"),
-            b,
-            Some(fit.residual_moment),
-            record,
-        ));
+        fitted.push((t.direction, format!("turned[{k}]"), b, Some(m0), record));
     }
     let mut fits: Vec<DirectionFit> = Vec::new();
-    for (direction, field, b, m0, (lambda, c, rms, elastic_rms, points)) in fitted {
+    for (direction, field, b, m0, (lambda, c, rms, elastic_rms, points, forward_model)) in fitted {
         let name = format!("{direction:?}");
         if fits.iter().any(|f| f.direction == name) {
             return Err(located(
@@ -450,6 +483,7 @@ pub fn fit_cloth(observations: &Path, out: &Path) -> Result<ClothFitReport, RunE
             two_hb_gf_cm_cm: two_hb,
             base_two_hb_gf_cm_cm: m0.map(|_| base_two_hb),
             elastic_rms_m: elastic_rms,
+            forward_model,
         });
     }
     spec.name = format!("{} (fitted to {})", spec.name, obs.name);

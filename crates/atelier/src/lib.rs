@@ -18,6 +18,7 @@ pub mod scenario;
 pub mod scene;
 pub mod sewing;
 pub mod simulation;
+pub mod strip;
 pub mod validate;
 pub mod wet;
 

@@ -6,14 +6,12 @@
 use std::path::PathBuf;
 
 use atelier::scenario::Scenario;
-use atelier_fabric::AnisotropyForm;
+use atelier::scenario::StripDirection;
+use atelier::strip::{TurnedRun, turned_strip};
 use atelier_fabric::Fabric;
 use atelier_fabric::noise::Rng;
 use atelier_fit::cloth::{ProfilePoint, fit_cantilever};
 use atelier_fit::turned::{TurnedProfile, fit_turned};
-use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
-use nalgebra::Vector3;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -200,114 +198,86 @@ fn atelier_fit_writes_a_fabric_with_the_fitted_rigidity() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The turned cantilever in the PARTY solver, hysteresis on: the strip of the Cantilever
-/// scenario (`segments` cells, overhang 2.0003·c, 1 cm wide, clamped by its first two rows)
-/// laid out straight, gravity applied over 1 s, then the clamp turned downwards about the
-/// platform edge at 45°/s, holding at each of `angles` until every node is slower than 1 mm/s;
-/// the centreline's free points in the fixed frame at each hold. The shape tolerance is
-/// 1e-8 m (the default 1e-6 m, at this Δt = 0.25·h, leaves the nodes jittering at cm/s).
+/// The turned strip of `fabric` along the warp or weft (`atelier::strip`, the default run but
+/// `segments` cells), overhanging by 3·c of its direction (the experimenter's choice, long
+/// enough that most of the strip is loaded beyond M₀/B; the fit is given only the overhang),
+/// observed at `angles`.
 fn turned(
     fabric: &Fabric,
     weft: bool,
     segments: usize,
     angles: &[f64],
 ) -> (Vec<TurnedProfile>, f64) {
-    let b = if weft {
-        fabric.bending.weft.rigidity()
+    let (b, direction) = if weft {
+        (fabric.bending.weft.rigidity(), StripDirection::Weft)
     } else {
-        fabric.bending.warp.rigidity()
+        (fabric.bending.warp.rigidity(), StripDirection::Warp)
     };
-    let length = 2.0003 * (b / fabric.weight_per_area()).cbrt();
-    let h = length / (segments as f64 + 0.5);
-    let nv = segments + 2;
-    let mut grid = StructuredGrid::sheet(2, nv, 0.01, (nv - 1) as f64 * h);
-    if weft {
-        grid.grain_angle = 0.0;
-    }
-    let topo = ClothTopology::from_structured(&grid).expect("grid");
-    let mut cloth = Cloth::new(topo, fabric, AnisotropyForm::Thesis).expect("cloth");
-    let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
-    let rest = cloth.topology().rest_positions().to_vec();
-    let clamp = |cloth: &mut Cloth, beta: f64| {
-        for (node, &r) in rest.iter().enumerate().take(4) {
-            let p = place(r);
-            let q = Vector3::new(p.x * beta.cos(), p.y, -p.x * beta.sin());
-            cloth.pin(node as u32, q, PinMotion::Fixed).expect("pin");
-        }
+    let length = 3.0 * (b / fabric.weight_per_area()).cbrt();
+    let run = TurnedRun {
+        segments,
+        ..TurnedRun::default()
     };
-    clamp(&mut cloth, 0.0);
-    let mut state = ClothState::placed(&cloth, place);
-    let mut params = StepParams {
-        dt: 0.25 * h,
-        damping: 5.0,
-        shape_tolerance: 1e-8,
-        implicit_stick_slope: true,
-        ..StepParams::default()
-    };
-    let g = params.gravity;
-    let mut solver = Solver::new();
-    let rate = 45f64.to_radians();
-    let mut beta = 0.0f64;
-    let mut profiles = Vec::new();
-    for &target in angles {
-        let target = target.to_radians();
-        let start = state.time;
-        loop {
-            let f = state.time.min(1.0);
-            params.gravity = g.map(|c| c * f);
-            if beta < target {
-                beta = (beta + rate * params.dt).min(target);
-                clamp(&mut cloth, beta);
-            }
-            solver.step(&cloth, &mut state, &params).expect("step");
-            let fastest = state
-                .velocities
-                .iter()
-                .map(|v| v.norm())
-                .fold(0.0, f64::max);
-            if f >= 1.0 && beta >= target && state.time - start > 0.5 && fastest < 1e-3 {
-                break;
-            }
-            assert!(state.time - start < 20.0, "not at rest: {fastest} m/s");
-        }
-        let points = (1..nv)
-            .map(|j| {
-                let p = (state.positions[2 * j] + state.positions[2 * j + 1]) * 0.5;
-                ProfilePoint {
-                    s: ((j as f64 - 0.5) * h).min(length),
-                    x: p.x,
-                    droop: -p.z,
-                }
-            })
-            .collect();
-        profiles.push(TurnedProfile {
-            clamp_deg: beta.to_degrees(),
-            points,
-        });
-    }
+    let profiles = turned_strip(fabric, direction, length, angles, &run).expect("turned strip");
     (profiles, length)
 }
 
+/// `profiles` with Gaussian noise of σ (m) on every coordinate, seeded.
+fn noisy(profiles: &[TurnedProfile], sigma: f64, seed: u64) -> Vec<TurnedProfile> {
+    let mut noise = Rng::new(seed);
+    profiles
+        .iter()
+        .map(|p| TurnedProfile {
+            points: p
+                .points
+                .iter()
+                .map(|q| ProfilePoint {
+                    x: q.x + sigma * noise.normal(),
+                    droop: q.droop + sigma * noise.normal(),
+                    ..*q
+                })
+                .collect(),
+            ..p.clone()
+        })
+        .collect()
+}
+
+/// Mean and sample spread of the (B, M₀) errors of several fits, in %.
+fn stats(draws: &[(f64, f64)]) -> [(f64, f64); 2] {
+    let n = draws.len() as f64;
+    let pick = |d: &(f64, f64), k: usize| if k == 0 { d.0 } else { d.1 };
+    [0, 1].map(|k| {
+        let mean = draws.iter().map(|d| pick(d, k)).sum::<f64>() / n;
+        let var = draws
+            .iter()
+            .map(|d| (pick(d, k) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        (100.0 * mean, 100.0 * var.sqrt())
+    })
+}
+
+/// The four strips of the hysteresis tests: fabric, weft?
+const STRIPS: [(&str, bool); 4] = [
+    ("wool_tropical", false),
+    ("silk", false),
+    ("silk", true),
+    ("cotton_broad", false),
+];
+
 /// Bending rigidity and hysteresis together from the turned cantilever simulated by the
 /// solver (hysteresis on; B and 2HB hidden: only the overhang, the weight per area and the
-/// profiles at 0°, 45° and 90° are used), fitted with the quasi-static spindle strip
-/// (`atelier_fit::turned`). Measured (docs/fit.md): the hysteresis explains the turned
-/// profiles (RMS 3–6 times below the best elastic strip's), but the solver's discrete strip
-/// at 10–16 cells is not the continuum strip — B comes out high and M₀ low, by an amount that
-/// falls with refinement for wool (B +12 → +7 %, M₀ −37 → −22 % from 10 to 16 cells) and
-/// hardly for cotton broad, whose loop is the widest (B about +100 %). Asserted: for wool
-/// tropical at 16 cells B within 12 %, M₀ within 30 %, the hysteretic RMS a third of the
-/// elastic one or less; for every case M₀ > 0 found; with 0.2 mm of noise on every point the
-/// mean of five draws stays within the same bounds.
+/// profiles at 0°, 90° and 180° are used), fitted with the continuum spindle strip
+/// (`atelier_fit::turned`). Measured (docs/fit.md): B is recovered for wool and silk (within
+/// 5 % at 16 cells), the hysteresis explains the profiles (RMS below the best elastic
+/// strip's: 0.16–0.50 of it), but M₀ comes out 20–55 % low — the solver's strip at 10–16 cells shows less set
+/// than the continuum strip with the same M₀ (the next test fits the solver's own M₀). Asserted:
+/// B within 8 % for wool and silk at 16 cells, also as the mean of five draws with 0.2 mm of
+/// noise for wool; M₀ > 0 found and the RMS under 0.6 of the elastic one everywhere.
 #[test]
 fn bending_hysteresis_is_recovered_from_a_turned_cantilever() {
-    let angles = [0.0, 45.0, 90.0];
-    for (name, weft) in [
-        ("wool_tropical", false),
-        ("silk", false),
-        ("silk", true),
-        ("cotton_broad", false),
-    ] {
+    let angles = [0.0, 90.0, 180.0];
+    for (name, weft) in STRIPS {
         let f = Fabric::load(&root().join(format!("fixtures/fabrics/{name}.ron"))).expect("fabric");
         let hidden = if weft { f.bending.weft } else { f.bending.warp };
         let w = f.weight_per_area();
@@ -322,71 +292,43 @@ fn bending_hysteresis_is_recovered_from_a_turned_cantilever() {
             let fit = fit_turned(&profiles, length, w).expect("fit");
             let (eb, em) = errors(&fit);
             let mut line = format!(
-                "{name} {} {segments} cells: B {:+.1} %, M0 {:+.1} %, RMS {:.3} mm (elastic {:.3} mm), set at 90° {:.2} mm, {} evaluations",
+                "{name} {} {segments} cells: B {:+.1} %, M0 {:+.1} %, RMS {:.3} mm (elastic {:.3} mm), {} evaluations",
                 if weft { "weft" } else { "warp" },
                 100.0 * eb,
                 100.0 * em,
                 fit.rms * 1e3,
                 fit.elastic_rms * 1e3,
-                profiles[2].points.last().expect("points").x * 1e3,
                 fit.evaluations,
             );
             assert!(
                 fit.residual_moment > 0.05 * hidden.residual_moment(),
                 "{line}"
             );
-            let wool = name == "wool_tropical" && segments == 16;
-            if wool {
-                assert!(eb.abs() < 0.12 && em.abs() < 0.30, "{line}");
-                assert!(fit.rms < fit.elastic_rms / 3.0, "{line}");
+            assert!(fit.rms < 0.6 * fit.elastic_rms, "{line}");
+            if name != "cotton_broad" && segments == 16 {
+                assert!(eb.abs() < 0.08, "{line}");
+            }
+            if name == "wool_tropical" && segments == 16 {
                 for sigma in [0.2e-3, 0.5e-3] {
-                    let mut draws = Vec::new();
-                    for seed in 0..5 {
-                        let mut noise = Rng::new(500 + seed);
-                        let noisy: Vec<TurnedProfile> = profiles
-                            .iter()
-                            .map(|p| TurnedProfile {
-                                points: p
-                                    .points
-                                    .iter()
-                                    .map(|q| ProfilePoint {
-                                        x: q.x + sigma * noise.normal(),
-                                        droop: q.droop + sigma * noise.normal(),
-                                        ..*q
-                                    })
-                                    .collect(),
-                                ..p.clone()
-                            })
-                            .collect();
-                        draws.push(errors(&fit_turned(&noisy, length, w).expect("fit")));
-                    }
-                    let n = draws.len() as f64;
-                    let mean = |k: usize| {
-                        draws
-                            .iter()
-                            .map(|d| if k == 0 { d.0 } else { d.1 })
-                            .sum::<f64>()
-                            / n
-                    };
-                    let spread = |k: usize| {
-                        let m = mean(k);
-                        (draws
-                            .iter()
-                            .map(|d| (if k == 0 { d.0 } else { d.1 } - m).powi(2))
-                            .sum::<f64>()
-                            / (n - 1.0))
-                            .sqrt()
-                    };
+                    let draws: Vec<(f64, f64)> = (0..5)
+                        .map(|seed| {
+                            errors(
+                                &fit_turned(&noisy(&profiles, sigma, 500 + seed), length, w)
+                                    .expect("fit"),
+                            )
+                        })
+                        .collect();
+                    let [b, m] = stats(&draws);
                     line.push_str(&format!(
                         "; σ {:.1} mm: B {:+.1} ± {:.1} %, M0 {:+.1} ± {:.1} %",
                         sigma * 1e3,
-                        100.0 * mean(0),
-                        100.0 * spread(0),
-                        100.0 * mean(1),
-                        100.0 * spread(1)
+                        b.0,
+                        b.1,
+                        m.0,
+                        m.1
                     ));
                     if sigma < 0.3e-3 {
-                        assert!(mean(0).abs() < 0.12 && mean(1).abs() < 0.30, "{line}");
+                        assert!(b.0.abs() < 8.0, "{line}");
                     }
                 }
             }
@@ -395,9 +337,81 @@ fn bending_hysteresis_is_recovered_from_a_turned_cantilever() {
     }
 }
 
-/// `atelier fit` with a turned strip: the warp's B and 2HB replaced by the fitted values (the
-/// wool strip at 16 cells: within the bias measured above), the weft's kept; a turned strip
-/// observed at one angle only is refused as not identifiable, with its place, nothing written.
+/// The solver's own B and M₀ (`atelier::strip::fit_turned_party`: the turned strip in the
+/// PARTY solver as the forward model, started from the continuum fit) from turned strips
+/// observed at 16 cells and fitted at 10 — a different discretisation, so the fit cannot
+/// simply replay its observations. Measured: B within 2 % and M₀ within 14 % for wool and
+/// silk, cotton B +7 %, M₀ −1 % (docs/fit.md). Asserted: B within 8 %, M₀ within 20 %, and the
+/// RMS below the continuum fit's; for wool the mean of three draws with 0.2 mm of noise within
+/// the same bounds.
+#[test]
+fn the_solver_hysteresis_is_recovered_through_the_solver() {
+    use atelier::strip::fit_turned_party;
+    let angles = [0.0, 90.0, 180.0];
+    let run = TurnedRun::default();
+    for (name, weft) in STRIPS {
+        if name == "silk" && weft {
+            continue; // the same fabric as silk warp, a quarter softer: no new case
+        }
+        let f = Fabric::load(&root().join(format!("fixtures/fabrics/{name}.ron"))).expect("fabric");
+        let hidden = if weft { f.bending.weft } else { f.bending.warp };
+        let w = f.weight_per_area();
+        let (profiles, length) = turned(&f, weft, 16, &angles);
+        let fit = |profiles: &[TurnedProfile]| {
+            let start = fit_turned(profiles, length, w).expect("continuum fit");
+            let party = fit_turned_party(
+                profiles,
+                length,
+                &f,
+                StripDirection::Warp,
+                &run,
+                (start.rigidity, start.residual_moment),
+            )
+            .expect("solver fit");
+            (start, party)
+        };
+        let errors = |b: f64, m0: f64| {
+            (
+                b / hidden.rigidity() - 1.0,
+                m0 / hidden.residual_moment() - 1.0,
+            )
+        };
+        let (start, party) = fit(&profiles);
+        let (eb, em) = errors(party.rigidity, party.residual_moment);
+        let mut line = format!(
+            "{name}: solver fit B {:+.2} %, M0 {:+.2} %, RMS {:.3} mm ({} runs, {}); continuum fit RMS {:.3} mm",
+            100.0 * eb,
+            100.0 * em,
+            party.rms * 1e3,
+            party.runs,
+            party.termination,
+            start.rms * 1e3
+        );
+        assert!(eb.abs() < 0.08 && em.abs() < 0.20, "{line}");
+        assert!(party.rms < start.rms, "{line}");
+        if name == "wool_tropical" {
+            let draws: Vec<(f64, f64)> = (0..3)
+                .map(|seed| {
+                    let p = fit(&noisy(&profiles, 0.2e-3, 700 + seed)).1;
+                    errors(p.rigidity, p.residual_moment)
+                })
+                .collect();
+            let [b, m] = stats(&draws);
+            line.push_str(&format!(
+                "; σ 0.2 mm: B {:+.1} ± {:.1} %, M0 {:+.1} ± {:.1} %",
+                b.0, b.1, m.0, m.1
+            ));
+            assert!(b.0.abs() < 8.0 && m.0.abs() < 20.0, "{line}");
+        }
+        eprintln!("{line}");
+    }
+}
+
+/// `atelier fit` with a turned strip: the warp's B and 2HB replaced by the fitted values, the
+/// weft's kept — through the continuum strip (the wool strip at 16 cells: B within 8 %, M₀
+/// within 30 %, the bias measured above) and, with `solver_cells: 10`, through the solver's
+/// own strip (within 8 % and 20 %); a turned strip observed at one angle only is refused as not
+/// identifiable, with its place, nothing written.
 #[test]
 fn atelier_fit_writes_the_fitted_hysteresis_of_a_turned_strip() {
     let dir = std::env::temp_dir().join(format!("atelier-fit-turned-{}", std::process::id()));
@@ -405,8 +419,8 @@ fn atelier_fit_writes_the_fitted_hysteresis_of_a_turned_strip() {
     std::fs::create_dir_all(&dir).expect("dir");
     let base = root().join("fixtures/fabrics/wool_tropical.ron");
     let wool = Fabric::load(&base).expect("fabric");
-    let (profiles, length) = turned(&wool, false, 16, &[0.0, 45.0, 90.0]);
-    let text = |profiles: &[TurnedProfile]| {
+    let (profiles, length) = turned(&wool, false, 16, &[0.0, 90.0, 180.0]);
+    let text = |profiles: &[TurnedProfile], extra: &str| {
         let entries: Vec<String> = profiles
             .iter()
             .map(|p| {
@@ -423,29 +437,39 @@ fn atelier_fit_writes_the_fitted_hysteresis_of_a_turned_strip() {
     name: "wool turned strip",
     provenance: "the PARTY solver's turned cantilever of wool tropical (test)",
     base: "{}",
-    turned: [(direction: Warp, overhang: {length}, profiles: [{}])],
+    turned: [(direction: Warp, overhang: {length}, profiles: [{}])],{extra}
 )"#,
             base.display(),
             entries.join(", ")
         )
     };
-    let file = dir.join("obs.ron");
-    std::fs::write(&file, text(&profiles)).expect("write");
-    let out = dir.join("out");
-    let report = atelier::fit::fit_cloth(&file, &out).expect("fits");
-    assert_eq!(report.fits[0].observation, "turned");
-    let fitted = Fabric::load(&out.join("fabric.ron")).expect("the fitted fabric reads back");
-    let (got, want) = (fitted.bending.warp, wool.bending.warp);
-    assert!(
-        (got.rigidity() / want.rigidity() - 1.0).abs() < 0.12
-            && (got.residual_moment() / want.residual_moment() - 1.0).abs() < 0.30,
-        "B {} against {}, M0 {} against {}",
-        got.rigidity(),
-        want.rigidity(),
-        got.residual_moment(),
-        want.residual_moment()
-    );
-    assert_eq!(fitted.bending.weft, wool.bending.weft);
+    for (extra, model, m0_bound) in [
+        ("", "spindle strip", 0.30),
+        (
+            "\n    solver_cells: Some(10),",
+            "PARTY solver, 10 cells",
+            0.20,
+        ),
+    ] {
+        let file = dir.join("obs.ron");
+        std::fs::write(&file, text(&profiles, extra)).expect("write");
+        let out = dir.join("out");
+        let report = atelier::fit::fit_cloth(&file, &out).expect("fits");
+        assert_eq!(report.fits[0].observation, "turned");
+        assert_eq!(report.fits[0].forward_model, model);
+        let fitted = Fabric::load(&out.join("fabric.ron")).expect("the fitted fabric reads back");
+        let (got, want) = (fitted.bending.warp, wool.bending.warp);
+        assert!(
+            (got.rigidity() / want.rigidity() - 1.0).abs() < 0.08
+                && (got.residual_moment() / want.residual_moment() - 1.0).abs() < m0_bound,
+            "{model}: B {} against {}, M0 {} against {}",
+            got.rigidity(),
+            want.rigidity(),
+            got.residual_moment(),
+            want.residual_moment()
+        );
+        assert_eq!(fitted.bending.weft, wool.bending.weft);
+    }
     let bad = dir.join("bad.ron");
     let one_angle: Vec<TurnedProfile> = profiles
         .iter()
@@ -455,7 +479,7 @@ fn atelier_fit_writes_the_fitted_hysteresis_of_a_turned_strip() {
             ..p.clone()
         })
         .collect();
-    std::fs::write(&bad, text(&one_angle)).expect("write");
+    std::fs::write(&bad, text(&one_angle, "")).expect("write");
     let e = atelier::fit::fit_cloth(&bad, &dir.join("bad_out")).expect_err("refused");
     let msg = e.to_string();
     assert!(
@@ -463,5 +487,52 @@ fn atelier_fit_writes_the_fitted_hysteresis_of_a_turned_strip() {
         "{msg}"
     );
     assert!(!dir.join("bad_out").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Why there is no tensile-scale fit from drape silhouettes (docs/fit.md): the JIS drape of wool
+/// tropical with both tensile curves 4 × softer and 4 × stiffer (EMT × 4 and ÷ 4) keeps its
+/// drape coefficient within 1.5 points and its node count of the unchanged fabric's — the
+/// silhouette does not carry the tensile scale (measured: DC 49.04 / 49.59 / 49.65 %, 9 nodes
+/// each, for ×0.25 / ×1 / ×4; the fabric hardly stretches under its own weight there).
+#[test]
+fn a_drape_silhouette_does_not_carry_the_tensile_scale() {
+    let dir = std::env::temp_dir().join(format!("atelier-tensile-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let text =
+        std::fs::read_to_string(root().join("fixtures/fabrics/wool_tropical.ron")).expect("fabric");
+    let drape = |k: f64| {
+        let scaled = text
+            .replace("emt_percent: 5.0", &format!("emt_percent: {}", 5.0 / k))
+            .replace("emt_percent: 7.0", &format!("emt_percent: {}", 7.0 / k));
+        assert_ne!(scaled, text, "the fixture's EMT values moved");
+        let name = format!("wool_k{}", (k * 100.0) as u32);
+        std::fs::write(dir.join(format!("{name}.ron")), scaled).expect("write");
+        let scenario = Scenario::parse(
+            &format!(
+                r#"(name: "{name}", reproduces: "tensile probe (test)", kind: Drape(fabric: "{name}.ron", tester: Jis, max_time: 5.0))"#
+            ),
+            &dir.join("s.ron"),
+        )
+        .expect("scenario");
+        let sim = atelier::run::simulate(&scenario, &dir, &mut |_| {}).expect("runs");
+        assert!(sim.failure.is_none(), "{:?}", sim.failure);
+        (
+            sim.metrics["drape_coefficient_percent"].expect("DC"),
+            sim.metrics["node_count"].expect("nodes"),
+        )
+    };
+    let (dc, nodes) = drape(1.0);
+    for k in [0.25, 4.0] {
+        let (dc_k, nodes_k) = drape(k);
+        eprintln!(
+            "tensile ×{k}: DC {dc_k:.2} % ({nodes_k} nodes) against {dc:.2} % ({nodes} nodes)"
+        );
+        assert!(
+            (dc_k - dc).abs() < 1.5 && nodes_k == nodes,
+            "×{k}: {dc_k} against {dc}"
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -77,7 +77,7 @@ impl TurnedStrip {
     }
 
     /// The centrelines at each clamp angle of `clamp_deg` (degrees, non-decreasing, in
-    /// [0, 180)), for rigidity B (N·m) and residual moment M₀ (N).
+    /// [0, 180]), for rigidity B (N·m) and residual moment M₀ (N).
     pub fn shapes(
         &self,
         rigidity: f64,
@@ -272,8 +272,8 @@ fn no_equilibrium(iterations: usize, residual: f64, r: &DVector<f64>) -> FitErro
 fn check_angles(clamp_deg: &[f64]) -> Result<(), FitError> {
     let mut last = 0.0;
     for (k, &a) in clamp_deg.iter().enumerate() {
-        if !(a.is_finite() && (0.0..180.0).contains(&a)) {
-            return Err(FitError::invalid("clamp_deg", k, a, "must be in [0, 180)"));
+        if !(a.is_finite() && (0.0..=180.0).contains(&a)) {
+            return Err(FitError::invalid("clamp_deg", k, a, "must be in [0, 180]"));
         }
         if a < last {
             return Err(FitError::invalid(

@@ -131,7 +131,7 @@ fn main() -> ExitCode {
                                 _ => String::new(),
                             };
                             println!(
-                                "{}: B = {:.4} gf·cm²/cm ({:.4e} N·m; base {:.4}){hysteresis}, c = {:.2} cm, RMS {:.3} mm over {} points ({})",
+                                "{}: B = {:.4} gf·cm²/cm ({:.4e} N·m; base {:.4}){hysteresis}, c = {:.2} cm, RMS {:.3} mm over {} points ({}, {})",
                                 f.direction,
                                 f.b_gf_cm2_cm,
                                 f.b_n_m,
@@ -139,7 +139,8 @@ fn main() -> ExitCode {
                                 f.bending_length_m * 100.0,
                                 f.rms_m * 1e3,
                                 f.points,
-                                f.observation
+                                f.observation,
+                                f.forward_model
                             );
                         }
                         println!("wrote {}", out.join("fabric.ron").display());

@@ -1,0 +1,316 @@
+//! The turned cantilever in the PARTY solver (`docs/fit.md`, bending hysteresis): the virtual
+//! instrument that observes a strip held horizontally and then with its clamp turned, and the
+//! forward model that fits the solver's own B and M₀ to such observations.
+//!
+//! The strip is the Cantilever scenario's (1 cm wide, two nodes across, clamped by its first
+//! two rows at ±h/2 about the clamp's edge), laid out straight; gravity comes on over
+//! `load_time`, then the clamp turns downwards about its edge at `rate_deg_s`, holding at each
+//! requested angle until every node is slower than `rest_speed`. The profiles are the
+//! centreline's free points in the fixed frame (x forward, droop downwards).
+
+use atelier_fabric::{AnisotropyForm, Fabric, Spindle};
+use atelier_fit::cloth::ProfilePoint;
+use atelier_fit::turned::TurnedProfile;
+use atelier_grid::{ClothTopology, StructuredGrid};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{DMatrix, DVector, Dyn, Owned, Vector3};
+
+use crate::run::RunError;
+use crate::scenario::StripDirection;
+
+/// How the turned strip is run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TurnedRun {
+    /// Cells along the overhang. Default 10.
+    pub segments: usize,
+    /// Damping c/S, kg/(m²·s). Default 5.
+    pub damping: f64,
+    /// Clamp turning rate, °/s. Default 45.
+    pub rate_deg_s: f64,
+    /// Time over which gravity comes on, s. Default 1.
+    pub load_time: f64,
+    /// Every node slower than this at a hold, m/s. Default 1e-3.
+    pub rest_speed: f64,
+    /// Longest hold, s. Default 30.
+    pub max_hold: f64,
+}
+
+impl Default for TurnedRun {
+    fn default() -> Self {
+        Self {
+            segments: 10,
+            damping: 5.0,
+            rate_deg_s: 45.0,
+            load_time: 1.0,
+            rest_speed: 1e-3,
+            max_hold: 30.0,
+        }
+    }
+}
+
+/// The strip of `fabric` cut along `direction`, overhanging by `overhang` (m), observed at
+/// each of `angles` (degrees, non-decreasing, in [0, 180]). Step parameters: Δt = 0.25·h,
+/// shape tolerance 1e-8 m (the default 1e-6 m over this Δt leaves the nodes jittering at cm/s),
+/// `implicit_stick_slope` on (without it a hysteretic strip chatters and never rests).
+pub fn turned_strip(
+    fabric: &Fabric,
+    direction: StripDirection,
+    overhang: f64,
+    angles: &[f64],
+    run: &TurnedRun,
+) -> Result<Vec<TurnedProfile>, RunError> {
+    let setup = |e: String| RunError::Setup(format!("turned strip: {e}"));
+    if !(overhang.is_finite() && overhang > 0.0) || run.segments < 4 {
+        return Err(setup(format!(
+            "overhang {overhang} m and {} cells: need a positive overhang and at least 4 cells",
+            run.segments
+        )));
+    }
+    let mut last = 0.0;
+    for &a in angles {
+        if !(a.is_finite() && (last..=180.0).contains(&a)) {
+            return Err(setup(format!(
+                "clamp angle {a}°: angles must rise from 0 to at most 180"
+            )));
+        }
+        last = a;
+    }
+    let segments = run.segments;
+    let h = overhang / (segments as f64 + 0.5);
+    let nv = segments + 2;
+    let mut grid = StructuredGrid::sheet(2, nv, 0.01, (nv - 1) as f64 * h);
+    if direction == StripDirection::Weft {
+        // Warp across the strip: the strip runs along the weft.
+        grid.grain_angle = 0.0;
+    }
+    let topo = ClothTopology::from_structured(&grid).map_err(|e| setup(e.to_string()))?;
+    let mut cloth =
+        Cloth::new(topo, fabric, AnisotropyForm::Thesis).map_err(|e| setup(e.to_string()))?;
+    let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
+    let rest = cloth.topology().rest_positions()[..4].to_vec();
+    let clamp = |cloth: &mut Cloth, beta: f64| -> Result<(), RunError> {
+        for (node, &r) in rest.iter().enumerate() {
+            let p = place(r);
+            let q = Vector3::new(p.x * beta.cos(), p.y, -p.x * beta.sin());
+            cloth
+                .pin(node as u32, q, PinMotion::Fixed)
+                .map_err(|e| setup(e.to_string()))?;
+        }
+        Ok(())
+    };
+    clamp(&mut cloth, 0.0)?;
+    let mut state = ClothState::placed(&cloth, place);
+    let mut params = StepParams {
+        dt: 0.25 * h,
+        damping: run.damping,
+        shape_tolerance: 1e-8,
+        implicit_stick_slope: true,
+        ..StepParams::default()
+    };
+    params.validate().map_err(|e| setup(e.to_string()))?;
+    let g = params.gravity;
+    let mut solver = Solver::new();
+    let rate = run.rate_deg_s.to_radians();
+    let mut beta = 0.0f64;
+    let mut profiles = Vec::with_capacity(angles.len());
+    for &target in angles {
+        let target = target.to_radians();
+        let start = state.time;
+        loop {
+            let f = (state.time / run.load_time).min(1.0);
+            params.gravity = g.map(|c| c * f);
+            if beta < target {
+                beta = (beta + rate * params.dt).min(target);
+                clamp(&mut cloth, beta)?;
+            }
+            solver
+                .step(&cloth, &mut state, &params)
+                .map_err(|e| setup(format!("at {:.1}°: {e}", beta.to_degrees())))?;
+            let fastest = state
+                .velocities
+                .iter()
+                .map(|v| v.norm())
+                .fold(0.0, f64::max);
+            if f >= 1.0 && beta >= target && state.time - start > 0.5 && fastest < run.rest_speed {
+                break;
+            }
+            if state.time - start > run.max_hold {
+                return Err(setup(format!(
+                    "not at rest {:.0} s after turning to {:.1}° (fastest node {fastest:.2e} m/s)",
+                    run.max_hold,
+                    beta.to_degrees()
+                )));
+            }
+        }
+        let points = (1..nv)
+            .map(|j| {
+                let p = (state.positions[2 * j] + state.positions[2 * j + 1]) * 0.5;
+                ProfilePoint {
+                    s: ((j as f64 - 0.5) * h).min(overhang),
+                    x: p.x,
+                    droop: -p.z,
+                }
+            })
+            .collect();
+        profiles.push(TurnedProfile {
+            clamp_deg: beta.to_degrees(),
+            points,
+        });
+    }
+    Ok(profiles)
+}
+
+/// The outcome of fitting the solver's own B and M₀ to turned-strip profiles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartyHysteresisFit {
+    /// Bending rigidity B, N·m.
+    pub rigidity: f64,
+    /// Residual moment M₀, N.
+    pub residual_moment: f64,
+    /// RMS distance of the points from the solver's strip, m.
+    pub rms: f64,
+    /// Solver runs made.
+    pub runs: usize,
+    /// How the minimiser ended.
+    pub termination: String,
+}
+
+struct PartyProblem<'a> {
+    base: &'a Fabric,
+    direction: StripDirection,
+    overhang: f64,
+    profiles: &'a [TurnedProfile],
+    angles: Vec<f64>,
+    run: TurnedRun,
+    p: DVector<f64>,
+    runs: std::cell::Cell<usize>,
+}
+
+impl PartyProblem<'_> {
+    fn residuals_at(&self, p: &DVector<f64>) -> Option<DVector<f64>> {
+        self.runs.set(self.runs.get() + 1);
+        let spindle = Spindle::new(p[0].exp(), p[1].exp()).ok()?;
+        let mut fabric = self.base.clone();
+        match self.direction {
+            StripDirection::Warp => fabric.bending.warp = spindle,
+            StripDirection::Weft => fabric.bending.weft = spindle,
+        }
+        let shapes = turned_strip(
+            &fabric,
+            self.direction,
+            self.overhang,
+            &self.angles,
+            &self.run,
+        )
+        .ok()?;
+        let rows: usize = self.profiles.iter().map(|p| p.points.len()).sum();
+        let mut r = DVector::zeros(2 * rows);
+        let mut row = 0;
+        for (observed, model) in self.profiles.iter().zip(&shapes) {
+            let line: Vec<(f64, f64, f64)> =
+                model.points.iter().map(|q| (q.s, q.x, q.droop)).collect();
+            for q in &observed.points {
+                let (x, y) = along(&line, q.s);
+                r[row] = x - q.x;
+                r[row + 1] = y - q.droop;
+                row += 2;
+            }
+        }
+        Some(r)
+    }
+}
+
+/// The point at arc length `s` on a polyline of `(s, x, droop)` (the clamp's edge at s = 0),
+/// linearly; beyond its ends, the end segment extended.
+fn along(line: &[(f64, f64, f64)], s: f64) -> (f64, f64) {
+    let mut prev = (0.0, 0.0, 0.0);
+    for (k, &q) in line.iter().enumerate() {
+        if s <= q.0 || k + 1 == line.len() {
+            let t = if q.0 > prev.0 {
+                (s - prev.0) / (q.0 - prev.0)
+            } else {
+                1.0
+            };
+            return (prev.1 + t * (q.1 - prev.1), prev.2 + t * (q.2 - prev.2));
+        }
+        prev = q;
+    }
+    (0.0, 0.0)
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for PartyProblem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.p.copy_from(x);
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.p.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        self.residuals_at(&self.p)
+    }
+
+    /// Central differences in (ln B, ln M₀) with a step of 1e-3.
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let r = self.residuals_at(&self.p)?;
+        let mut jac = DMatrix::zeros(r.len(), 2);
+        for c in 0..2 {
+            let d = 1e-3;
+            let (mut a, mut b) = (self.p.clone(), self.p.clone());
+            a[c] += d;
+            b[c] -= d;
+            let col = (self.residuals_at(&a)? - self.residuals_at(&b)?) / (2.0 * d);
+            jac.set_column(c, &col);
+        }
+        Some(jac)
+    }
+}
+
+/// Fit the solver's B and M₀ of `direction` (every other value of `base` kept) so that its
+/// turned strip (`run`) passes nearest the observed profiles; start from `start` (B, M₀) —
+/// the continuum strip's fit (`atelier_fit::turned::fit_turned`) is a good one.
+/// Levenberg–Marquardt (the `levenberg-marquardt` crate) on (ln B, ln M₀).
+pub fn fit_turned_party(
+    profiles: &[TurnedProfile],
+    overhang: f64,
+    base: &Fabric,
+    direction: StripDirection,
+    run: &TurnedRun,
+    start: (f64, f64),
+) -> Result<PartyHysteresisFit, RunError> {
+    let angles: Vec<f64> = profiles.iter().map(|p| p.clamp_deg).collect();
+    let problem = PartyProblem {
+        base,
+        direction,
+        overhang,
+        profiles,
+        angles,
+        run: *run,
+        p: DVector::from_vec(vec![start.0.ln(), start.1.ln()]),
+        runs: std::cell::Cell::new(0),
+    };
+    let r0 = problem.residuals_at(&problem.p).ok_or_else(|| {
+        RunError::Setup(format!(
+            "turned strip: the solver's strip does not come to rest at the start B {:.3e} N·m, M₀ {:.3e} N",
+            start.0, start.1
+        ))
+    })?;
+    let rows = r0.len() / 2;
+    let (problem, report) = LevenbergMarquardt::new().minimize(problem);
+    let cost = problem
+        .residuals_at(&problem.p)
+        .map_or(f64::NAN, |r| r.norm_squared());
+    Ok(PartyHysteresisFit {
+        rigidity: problem.p[0].exp(),
+        residual_moment: problem.p[1].exp(),
+        rms: (cost / rows as f64).sqrt(),
+        runs: problem.runs.get(),
+        termination: format!("{:?}", report.termination),
+    })
+}
