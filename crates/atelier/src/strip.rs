@@ -10,7 +10,7 @@
 
 use atelier_fabric::{AnisotropyForm, Fabric, Spindle};
 use atelier_fit::cloth::ProfilePoint;
-use atelier_fit::turned::TurnedProfile;
+use atelier_fit::turned::{TurnedProfile, central_differences};
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
@@ -258,17 +258,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for PartyProblem<'_> {
 
     /// Central differences in (ln B, ln M₀) with a step of 1e-3.
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let r = self.residuals_at(&self.p)?;
-        let mut jac = DMatrix::zeros(r.len(), 2);
-        for c in 0..2 {
-            let d = 1e-3;
-            let (mut a, mut b) = (self.p.clone(), self.p.clone());
-            a[c] += d;
-            b[c] -= d;
-            let col = (self.residuals_at(&a)? - self.residuals_at(&b)?) / (2.0 * d);
-            jac.set_column(c, &col);
-        }
-        Some(jac)
+        central_differences(&self.p, 1e-3, |p| self.residuals_at(p))
     }
 }
 

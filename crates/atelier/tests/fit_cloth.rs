@@ -530,7 +530,7 @@ fn a_drape_silhouette_does_not_carry_the_tensile_scale() {
             "tensile ×{k}: DC {dc_k:.2} % ({nodes_k} nodes) against {dc:.2} % ({nodes} nodes)"
         );
         assert!(
-            (dc_k - dc).abs() < 1.5 && nodes_k == nodes,
+            (dc_k - dc).abs() < 1.5 && (nodes_k - nodes).abs() < 0.5,
             "×{k}: {dc_k} against {dc}"
         );
     }

@@ -371,17 +371,25 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     /// Central differences in (ln B, ln M₀): the path's reversals make the shapes only
     /// piecewise smooth in the parameters, and a step of 1e-4 sees through the kinks.
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let mut jac = DMatrix::zeros(self.rows(), 2);
-        for c in 0..2 {
-            let d = 1e-4;
-            let (mut a, mut b) = (self.p.clone(), self.p.clone());
-            a[c] += d;
-            b[c] -= d;
-            let col = (self.residuals_at(&a)? - self.residuals_at(&b)?) / (2.0 * d);
-            jac.set_column(c, &col);
-        }
-        Some(jac)
+        central_differences(&self.p, 1e-4, |p| self.residuals_at(p))
     }
+}
+
+/// The Jacobian of `residuals` at `p` by central differences with `step` in every parameter
+/// (None when a residual evaluation fails).
+pub fn central_differences(
+    p: &DVector<f64>,
+    step: f64,
+    residuals: impl Fn(&DVector<f64>) -> Option<DVector<f64>>,
+) -> Option<DMatrix<f64>> {
+    let mut columns = Vec::with_capacity(p.len());
+    for c in 0..p.len() {
+        let (mut a, mut b) = (p.clone(), p.clone());
+        a[c] += step;
+        b[c] -= step;
+        columns.push((residuals(&a)? - residuals(&b)?) / (2.0 * step));
+    }
+    Some(DMatrix::from_columns(&columns))
 }
 
 /// Fit B and M₀ to profiles of one strip (overhang `length` m, weight per area `weight`
