@@ -414,6 +414,9 @@ fn default_catenary_time() -> f64 {
     10.0
 }
 
+/// The most frames a scenario may record.
+pub const MAX_FRAMES: usize = 100_000;
+
 impl Scenario {
     /// Read and check a scenario file.
     pub fn load(path: &Path) -> Result<Self, FileError> {
@@ -497,6 +500,33 @@ impl Scenario {
                 "say what the scenario reproduces".into(),
             );
         }
+        // A run records a frame per interval: a tiny interval over a long run would exhaust
+        // memory before it failed.
+        let frames = |field: &str, duration: f64, interval: f64| -> Result<(), InvalidValue> {
+            let n = duration / interval;
+            if n > MAX_FRAMES as f64 {
+                bad(
+                    field,
+                    ErrorKind::OutOfRange,
+                    format!(
+                        "{duration} s every {interval} s is {n:.0} frames; record at most {MAX_FRAMES}"
+                    ),
+                )
+            } else {
+                Ok(())
+            }
+        };
+        let at_most = |field: &str, n: usize, max: usize, what: &str| -> Result<(), InvalidValue> {
+            if n > max {
+                bad(
+                    field,
+                    ErrorKind::OutOfRange,
+                    format!("{n} {what}: at most {max}"),
+                )
+            } else {
+                Ok(())
+            }
+        };
         let positive = |field: &str, v: f64| -> Result<(), InvalidValue> {
             if !v.is_finite() {
                 bad(field, ErrorKind::NotFinite, format!("{v}"))
@@ -528,6 +558,22 @@ impl Scenario {
                         "need at least 3 nodes around and 2 rings".into(),
                     );
                 }
+                at_most(
+                    "kind.n_around",
+                    d.n_around.unwrap_or(0),
+                    10_000,
+                    "nodes around",
+                )?;
+                at_most("kind.n_rings", d.n_rings.unwrap_or(0), 10_000, "rings")?;
+                at_most(
+                    "kind.n_around",
+                    d.n_around
+                        .unwrap_or(0)
+                        .saturating_mul(d.n_rings.unwrap_or(0)),
+                    1_000_000,
+                    "nodes (around × rings)",
+                )?;
+                frames("kind.frame_interval", d.max_time, d.frame_interval)?;
             }
             ScenarioKind::Cantilever(c) => {
                 if c.segments < 4 {
@@ -543,6 +589,8 @@ impl Scenario {
                 positive("kind.damping", c.damping)?;
                 positive("kind.max_time", c.max_time)?;
                 positive("kind.frame_interval", c.frame_interval)?;
+                at_most("kind.segments", c.segments, 10_000, "cells")?;
+                frames("kind.frame_interval", c.max_time, c.frame_interval)?;
             }
             ScenarioKind::KesTensile(k) => {
                 positive("kind.max_force_gf_cm", k.max_force_gf_cm)?;
@@ -646,6 +694,8 @@ impl Scenario {
                 positive("kind.duration", c.duration)?;
                 positive("kind.damping", c.damping)?;
                 positive("kind.frame_interval", c.frame_interval)?;
+                at_most("kind.segments", c.segments, 100_000, "cells")?;
+                frames("kind.frame_interval", c.duration, c.frame_interval)?;
             }
         }
         let names = self.kind.metric_names();

@@ -163,6 +163,30 @@ fn finish(
             ),
         ));
     }
+    // A face without area has no normal: distance queries and inside/outside tests would
+    // take an arbitrary side for it. Refused with its line (faces are triangulated fans, so a
+    // polygon's degenerate part is named by the polygon's line).
+    for (t, _, line) in &faces {
+        let [a, b, c] = t.map(|k| vertices[k as usize]);
+        let (u, v) = (b - a, c - a);
+        let scale = u
+            .norm_squared()
+            .max(v.norm_squared())
+            .max((c - b).norm_squared());
+        if u.cross(&v).norm() <= 1e-12 * scale || scale == 0.0 {
+            return Err(err(
+                file,
+                Some(*line),
+                ErrorKind::Inconsistent,
+                format!(
+                    "face ({}, {}, {}) (1-based vertices) has zero area: its corners repeat or lie on one line",
+                    t[0] + 1,
+                    t[1] + 1,
+                    t[2] + 1
+                ),
+            ));
+        }
+    }
     let triangles: Vec<[u32; 3]> = faces.iter().map(|f| f.0).collect();
     let triangle_part: Option<Vec<Part>> = faces.iter().map(|f| f.1).collect();
     let vertex_part = vertex_part.or_else(|| {
@@ -646,7 +670,7 @@ mod tests {
         assert_eq!(e.kind, ErrorKind::TooShort, "{e}");
     }
 
-    const PLY: &str = "ply\nformat ascii 1.0\ncomment test\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty int part\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0 4\n1 0 0 4\n0 1 0 11\n0 0 1 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n4 1 2 3 1\n";
+    const PLY: &str = "ply\nformat ascii 1.0\ncomment test\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty int part\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0 4\n1 0 0 4\n0 1 0 11\n0 0 1 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n4 1 2 3 0\n";
 
     fn ply(text: &str) -> Result<ExternalBody, FileError> {
         parse_ply(text, Path::new("t.ply"), &LoadOptions::default())
@@ -667,7 +691,15 @@ mod tests {
             ])
         );
         assert_eq!(b.triangle_part.as_ref().map(|t| t[0]), Some(Part::Pelvis));
-        assert!(!b.closed, "the quad repeats a vertex");
+        assert!(
+            !b.closed,
+            "the quad's second triangle repeats the edge 1 → 3"
+        );
+        // A face that repeats a vertex has a triangle without area: refused with its line.
+        let e = ply(&PLY.replace("4 1 2 3 0", "4 1 2 3 1")).expect_err("zero area");
+        assert_eq!(e.kind, ErrorKind::Inconsistent, "{e}");
+        assert_eq!(e.position.map(|p| p.line), Some(19));
+        assert!(e.message.contains("zero area"), "{e}");
         let e = ply(&PLY.replace("0 1 0 11", "0 nan 0 11")).expect_err("NaN");
         assert_eq!(e.kind, ErrorKind::NotFinite, "{e}");
         assert_eq!(e.position.map(|p| p.line), Some(14));
@@ -678,7 +710,7 @@ mod tests {
         assert_eq!(e.kind, ErrorKind::OutOfRange, "{e}");
         let e = ply(&PLY.replace("ascii", "binary_little_endian")).expect_err("binary");
         assert_eq!(e.kind, ErrorKind::Syntax, "{e}");
-        let e = ply(&PLY.replace("4 1 2 3 1\n", "")).expect_err("truncated");
+        let e = ply(&PLY.replace("4 1 2 3 0\n", "")).expect_err("truncated");
         assert_eq!(e.kind, ErrorKind::TooShort, "{e}");
     }
 

@@ -132,6 +132,16 @@ pub fn load_garment(path: &Path, params: ImproveParams) -> Result<Garment, FileE
         };
         let (pa, na) = find(&s.a)?;
         let (pb, mut nb) = find(&s.b)?;
+        if pa == pb && s.a.1 == s.b.1 {
+            return Err(fail(
+                k,
+                ErrorKind::Inconsistent,
+                format!(
+                    "seam `{}` joins team `{}` of panel `{}` to itself; a seam joins two different teams (a panel sewn to itself joins two of its own teams, as a tube)",
+                    s.name, s.a.1, s.a.0
+                ),
+            ));
+        }
         if na.len() != nb.len() {
             return Err(fail(
                 k,

@@ -299,6 +299,11 @@ fn invalid(kind: ErrorKind, field: impl Into<String>, message: impl Into<String>
     InvalidValue::new(kind, field, message)
 }
 
+/// The most nodes one panel's grid may have (a 1000 × 1000 grid; the scaling benchmarks go
+/// to 100 000 nodes). A larger count is almost certainly a typo, and would exhaust memory
+/// rather than fail.
+pub const MAX_PANEL_NODES: usize = 1_000_000;
+
 impl Validate for PatternSpec {
     fn validate(&self) -> Result<(), InvalidValue> {
         for (field, p) in self.points() {
@@ -348,7 +353,11 @@ impl Validate for PatternSpec {
                 ));
             }
         }
-        let total = |k: usize| sides[k].iter().map(|t| t.cells).sum::<usize>();
+        let total = |k: usize| {
+            sides[k]
+                .iter()
+                .fold(0usize, |a, t| a.saturating_add(t.cells))
+        };
         let close = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]) <= 1e-6;
         match &self.outline {
             Outline::Quad {
@@ -384,6 +393,18 @@ impl Validate for PatternSpec {
                             ),
                         ));
                     }
+                }
+                let nodes = (total(0).saturating_add(1)).saturating_mul(total(1).saturating_add(1));
+                if nodes > MAX_PANEL_NODES {
+                    return Err(invalid(
+                        ErrorKind::OutOfRange,
+                        "outline",
+                        format!(
+                            "{} × {} cells make {nodes} nodes; a panel may have at most {MAX_PANEL_NODES}",
+                            total(0),
+                            total(1)
+                        ),
+                    ));
                 }
                 let end = *sides[3]
                     .last()
@@ -431,6 +452,17 @@ impl Validate for PatternSpec {
                         "a ring needs at least 1 radial cell",
                     ));
                 }
+                let nodes = total(0).saturating_mul(radial_cells.saturating_add(1));
+                if nodes > MAX_PANEL_NODES {
+                    return Err(invalid(
+                        ErrorKind::OutOfRange,
+                        "outline",
+                        format!(
+                            "{} × {radial_cells} cells make {nodes} nodes; a panel may have at most {MAX_PANEL_NODES}",
+                            total(0)
+                        ),
+                    ));
+                }
                 for (k, start, name) in [(0, inner_start, "inner"), (1, outer_start, "outer")] {
                     let end = *sides[k]
                         .last()
@@ -461,6 +493,26 @@ impl Validate for PatternSpec {
                 format!(
                     "the outline crosses itself near ({:.2}, {:.2}) and ({:.2}, {:.2})",
                     poly[a][0], poly[a][1], poly[b][0], poly[b][1]
+                ),
+            ));
+        }
+        // A boundary that folds back along itself (all corners on a line) crosses nowhere but
+        // encloses nothing: say so here rather than as a grid without a cell of positive area.
+        let (area, perimeter) =
+            poly.iter()
+                .zip(poly.iter().cycle().skip(1))
+                .fold((0.0, 0.0), |(a, l), (p, q)| {
+                    (
+                        a + 0.5 * (p[0] * q[1] - q[0] * p[1]),
+                        l + (q[0] - p[0]).hypot(q[1] - p[1]),
+                    )
+                });
+        if area.abs() <= 1e-9 * perimeter * perimeter {
+            return Err(invalid(
+                ErrorKind::Inconsistent,
+                "outline",
+                format!(
+                    "the outline encloses no area ({area:.3e} cm² inside a boundary of {perimeter:.2} cm): its sides are collinear or run back along each other"
                 ),
             ));
         }

@@ -1,0 +1,217 @@
+//! Degenerate geometry (issue 10): each case gives a clear error naming the file, place and
+//! field, or a documented behaviour (`docs/hostile.md`).
+
+use std::path::{Path, PathBuf};
+
+use atelier_fabric::ErrorKind;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .expect("repository root")
+}
+
+fn scratch(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("atelier-degenerate-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch");
+    dir
+}
+
+/// A quad pattern with the given four side ends (cm) and cells per side.
+fn quad(name: &str, corners: [(f64, f64); 3], cells: usize) -> String {
+    let [b, r, t] = corners;
+    format!(
+        r#"(
+    name: "{name}",
+    provenance: "degenerate-geometry test",
+    grain: ((25.0, 0.0), (25.0, 50.0)),
+    outline: Quad(
+        start: (0.0, 0.0),
+        bottom: [(name: "bottom", cells: {cells}, path: [Line({}, {})])],
+        right: [(name: "right", cells: {cells}, path: [Line({}, {})])],
+        top: [(name: "top", cells: {cells}, path: [Line({}, {})])],
+        left: [(name: "left", cells: {cells}, path: [Line(0.0, 0.0)])],
+    ),
+)"#,
+        b.0, b.1, r.0, r.1, t.0, t.1
+    )
+}
+
+fn load_pattern(dir: &Path, text: &str) -> Result<atelier_grid::pattern::Panel, String> {
+    let path = dir.join("p.ron");
+    std::fs::write(&path, text).expect("write");
+    let spec = atelier_grid::pattern::load_pattern(&path).map_err(|e| e.to_string())?;
+    atelier_grid::pattern::grid_pattern(&spec, atelier_grid::ImproveParams::default())
+        .map_err(|e| e.to_string())
+}
+
+/// A pattern whose corners all lie on one line (the boundary runs out and back) crosses itself
+/// nowhere but encloses nothing: refused as such, naming the outline — not as a grid that
+/// "cannot be cooked".
+#[test]
+fn a_collinear_outline_is_refused() {
+    let dir = scratch("collinear");
+    let e = load_pattern(
+        &dir,
+        &quad("line", [(50.0, 0.0), (100.0, 0.0), (50.0, 0.0)], 10),
+    )
+    .expect_err("refused");
+    assert!(
+        e.contains("p.ron:") && e.contains("`outline`") && e.contains("encloses no area"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Two coincident corners make a side of zero length: refused, naming the team's path.
+#[test]
+fn coincident_corners_are_refused() {
+    let dir = scratch("coincident");
+    let e = load_pattern(
+        &dir,
+        &quad("pinch", [(50.0, 0.0), (50.0, 0.0), (0.0, 50.0)], 10),
+    )
+    .expect_err("refused");
+    assert!(
+        e.contains("outline.right[0].path") && e.contains("zero length"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A panel of 10¹⁰ nodes (100 000 cells a side: a typo) is refused from its numbers before
+/// anything is allocated (it used to abort the process asking for 160 GB).
+#[test]
+fn a_panel_too_large_is_refused_before_it_is_gridded() {
+    let dir = scratch("huge");
+    let e = load_pattern(
+        &dir,
+        &quad("huge", [(50.0, 0.0), (50.0, 50.0), (0.0, 50.0)], 100_000),
+    )
+    .expect_err("refused");
+    assert!(
+        e.contains("`outline`") && e.contains("at most 1000000"),
+        "{e}"
+    );
+    let ok = load_pattern(
+        &dir,
+        &quad("fine", [(50.0, 0.0), (50.0, 50.0), (0.0, 50.0)], 99),
+    )
+    .expect("a 100 × 100 grid");
+    assert_eq!(ok.topology.node_count(), 100 * 100);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A seam that joins a team to itself is refused with the seam's place; a seam joining two
+/// teams of one panel (a tube) is allowed.
+#[test]
+fn a_seam_joining_a_team_to_itself_is_refused() {
+    let dir = scratch("seam");
+    std::fs::copy(
+        root().join("fixtures/patterns/dress/front_skirt.ron"),
+        dir.join("front_skirt.ron"),
+    )
+    .expect("copy");
+    let garment = |a: &str, b: &str| {
+        format!(
+            r#"(name: "g", provenance: "degenerate-geometry test", panels: [(name: "front skirt", pattern: "front_skirt.ron")],
+    seams: [(name: "s", a: ("front skirt", "{a}"), b: ("front skirt", "{b}"), reversed: false)])"#
+        )
+    };
+    let path = dir.join("g.ron");
+    std::fs::write(&path, garment("side +x", "side +x")).expect("write");
+    let e = atelier_grid::pattern::load_garment(&path, atelier_grid::ImproveParams::default())
+        .expect_err("refused");
+    assert_eq!(e.kind, ErrorKind::Inconsistent, "{e}");
+    assert_eq!(e.field, "seams[0]");
+    assert_eq!(e.position.map(|p| p.line), Some(2), "{e}");
+    assert!(e.message.contains("to itself"), "{e}");
+    std::fs::write(&path, garment("side +x", "side -x")).expect("write");
+    let tube = atelier_grid::pattern::load_garment(&path, atelier_grid::ImproveParams::default())
+        .expect("a panel sewn to itself along two teams");
+    assert_eq!(tube.seams[0].panel_a, tube.seams[0].panel_b);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const TETRA: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+
+fn obj(
+    text: &str,
+    closed: bool,
+) -> Result<atelier_body::io::ExternalBody, atelier_fabric::FileError> {
+    let opts = atelier_body::io::LoadOptions {
+        require_closed: closed,
+        scale: 1.0,
+    };
+    atelier_body::io::parse_obj(text, Path::new("b.obj"), &opts)
+}
+
+/// A body mesh with a hole: refused when a closed mesh is required (the open edge and its
+/// face's line named), read with `closed: false` otherwise.
+#[test]
+fn a_body_mesh_with_a_hole_is_refused_or_marked_open() {
+    let holed = TETRA.replace("f 3 1 4\n", "");
+    assert!(obj(TETRA, true).expect("closed").closed);
+    let e = obj(&holed, true).expect_err("refused");
+    assert_eq!(e.kind, ErrorKind::Inconsistent, "{e}");
+    assert!(
+        e.position.is_some() && e.message.contains("not closed"),
+        "{e}"
+    );
+    assert!(!obj(&holed, false).expect("read").closed);
+}
+
+/// A face without area (three corners on a line, or a corner repeated) is refused with its
+/// line, closed mesh required or not: it has no normal, so no side.
+#[test]
+fn a_zero_area_face_is_refused_with_its_line() {
+    for (bad, line) in [
+        (TETRA.replace("f 3 1 4\n", "f 3 1 4\nf 1 2 2\n"), 9),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 2 0 0\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\nf 1 2 5\n"
+                .to_string(),
+            10,
+        ),
+    ] {
+        for closed in [false, true] {
+            let e = obj(&bad, closed).expect_err("refused");
+            assert_eq!(e.kind, ErrorKind::Inconsistent, "{e}");
+            assert_eq!(e.position.map(|p| p.line), Some(line), "{e}");
+            assert!(e.message.contains("zero area"), "{e}");
+        }
+    }
+}
+
+/// A sheet of zero width has no cell with a positive area: the topology refuses it.
+#[test]
+fn a_sheet_without_area_is_refused() {
+    let grid = atelier_grid::StructuredGrid::sheet(3, 3, 0.0, 1.0);
+    let e = atelier_grid::ClothTopology::from_structured(&grid).expect_err("refused");
+    assert!(e.to_string().contains("positive area"), "{e}");
+}
+
+/// Sizes that would exhaust memory before anything failed are refused when the scenario is
+/// read: a drape of 10⁸ nodes, a cantilever of 10⁶ cells, 10¹¹ frames.
+#[test]
+fn a_scene_too_large_is_refused_when_read() {
+    let drape = |extra: &str| {
+        format!(
+            r#"(name: "d", reproduces: "degenerate-geometry test", kind: Drape(fabric: "../fabrics/silk.ron", tester: Jis{extra}))"#
+        )
+    };
+    for (text, field) in [
+        (drape(", n_around: 10000, n_rings: 10000"), "kind.n_around"),
+        (drape(", max_time: 1000.0, frame_interval: 1e-8"), "kind.frame_interval"),
+        (
+            r#"(name: "c", reproduces: "degenerate-geometry test", kind: Cantilever(fabric: "../fabrics/silk.ron", segments: 1000000))"#
+                .to_string(),
+            "kind.segments",
+        ),
+    ] {
+        let e = atelier::scenario::Scenario::parse(&text, Path::new("s.ron")).expect_err(field);
+        assert_eq!(e.field, field, "{e}");
+        assert_eq!(e.kind, ErrorKind::OutOfRange, "{e}");
+    }
+}
