@@ -26,6 +26,9 @@
 //!   baselines with their bending hinges on, as PARTY computes bending); the mass-spring step is
 //!   explicit, so its table row also gives the time per 0.01 s of simulated time.
 //!
+//! - `scaling` (issue 10): time per step with 1 and 2 threads and resident memory per node from
+//!   289 to 100 489 nodes; a table, not a criterion group (see [`scaling`]).
+//!
 //! `cargo test --benches` runs each bench once (criterion's test mode) with one step per stage
 //! median, so CI checks the answers in about 15 s (mostly the 40 000-node warm-up) without
 //! timing anything.
@@ -565,5 +568,105 @@ fn baselines(c: &mut Criterion) {
     write_report("solver_baselines.md", &text);
 }
 
-criterion_group!(benches, party, baselines);
+/// Resident memory of this process, bytes (`/proc/self/statm`; 0 where there is none).
+fn resident_bytes() -> usize {
+    std::fs::read_to_string("/proc/self/statm")
+        .ok()
+        .and_then(|s| s.split_whitespace().nth(1)?.parse::<usize>().ok())
+        .map_or(0, |pages| pages * 4096)
+}
+
+/// Sides of the scaling sheets: 289 to 100 489 nodes.
+const SCALING_SIDES: [usize; 7] = [17, 32, 71, 100, 158, 224, 317];
+
+/// Scaling (issue 10): wall time per step with 1 and 2 rayon threads and resident memory per
+/// node, from 289 to 100 489 nodes (the sheet of [`Fixture`]). Per size: the resident memory
+/// added by building the scene, warming it up and stepping once (cloth, state, solver and its
+/// scratch; measured as the growth of the process's resident set, so at 4 kB resolution), then
+/// per thread count the median of at least three steps (until 2 s) from clones of the same
+/// warmed-up state. Table: stderr and `$CARGO_TARGET_DIR/atelier-bench/scaling.md`, with the
+/// slope of log time against log nodes from 10 000 nodes up. `cargo test --benches` runs the
+/// smallest size only.
+fn scaling(_c: &mut Criterion) {
+    let fabric = cotton();
+    let sides: &[usize] = if measuring() {
+        &SCALING_SIDES
+    } else {
+        &SCALING_SIDES[..1]
+    };
+    let pools: Vec<(usize, rayon::ThreadPool)> = [1, 2]
+        .into_iter()
+        .map(|t| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .expect("thread pool");
+            (t, pool)
+        })
+        .collect();
+    let mut table = String::from(
+        "| nodes | edges | 1 thread, ms/step | 2 threads, ms/step | speed-up | µs per node (2 threads) | resident bytes per node |\n|---|---|---|---|---|---|---|\n",
+    );
+    let mut points = Vec::new();
+    for &side in sides {
+        let before = resident_bytes();
+        let mut fx = Fixture::new(&fabric, side);
+        let (nodes, edges) = (fx.nodes(), fx.edges());
+        let per_thread: Vec<f64> = pools
+            .iter()
+            .map(|(_, pool)| {
+                pool.install(|| {
+                    let mut times = Vec::new();
+                    let budget = Instant::now();
+                    while times.len() < 3
+                        || (measuring() && budget.elapsed().as_secs_f64() < 2.0 && times.len() < 50)
+                    {
+                        let mut state = fx.state.clone();
+                        let t0 = Instant::now();
+                        fx.solver
+                            .step(&fx.cloth, &mut state, &fx.params)
+                            .expect("step");
+                        times.push(t0.elapsed().as_secs_f64());
+                        black_box(&state);
+                    }
+                    median_f64(times)
+                })
+            })
+            .collect();
+        let memory = resident_bytes().saturating_sub(before) as f64 / nodes as f64;
+        points.push((nodes as f64, per_thread[1]));
+        let _ = writeln!(
+            table,
+            "| {nodes} | {edges} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} |",
+            per_thread[0] * 1e3,
+            per_thread[1] * 1e3,
+            per_thread[0] / per_thread[1],
+            per_thread[1] * 1e6 / nodes as f64,
+            memory
+        );
+        drop(fx);
+    }
+    let large: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.0 >= 10_000.0).collect();
+    if large.len() >= 2 {
+        let n = large.len() as f64;
+        let (mx, my) = large
+            .iter()
+            .fold((0.0, 0.0), |a, p| (a.0 + p.0.ln() / n, a.1 + p.1.ln() / n));
+        let (num, den) = large.iter().fold((0.0, 0.0), |a, p| {
+            (
+                a.0 + (p.0.ln() - mx) * (p.1.ln() - my),
+                a.1 + (p.0.ln() - mx).powi(2),
+            )
+        });
+        let _ = writeln!(
+            table,
+            "\nSlope of log(time per step) against log(nodes), 10 000 nodes and up, 2 threads: {:.3}",
+            num / den
+        );
+    }
+    eprintln!("{table}");
+    write_report("scaling.md", &table);
+}
+
+criterion_group!(benches, party, baselines, scaling);
 criterion_main!(benches);
