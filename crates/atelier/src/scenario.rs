@@ -537,7 +537,15 @@ impl Scenario {
             }
         };
         match &self.kind {
-            ScenarioKind::Garment(g) => g.settings.check().map_err(|e| e.within("kind"))?,
+            ScenarioKind::Garment(g) => {
+                g.settings.check().map_err(|e| e.within("kind"))?;
+                let s = &g.settings;
+                frames(
+                    "kind.settings.frame_interval",
+                    s.sew_limit + s.settle + s.motion_time,
+                    s.frame_interval,
+                )?;
+            }
             ScenarioKind::Drape(d) => {
                 if let Some(dt) = d.dt {
                     positive("kind.dt", dt)?;

@@ -245,19 +245,6 @@ impl Settings {
                 ));
             }
         }
-        let total = self.sew_limit + self.settle + self.motion_time;
-        let frames = total / self.frame_interval;
-        if frames > crate::scenario::MAX_FRAMES as f64 {
-            return Err(InvalidValue::new(
-                ErrorKind::OutOfRange,
-                "settings.frame_interval",
-                format!(
-                    "{total} s every {} s is {frames:.0} frames; record at most {}",
-                    self.frame_interval,
-                    crate::scenario::MAX_FRAMES
-                ),
-            ));
-        }
         if let Dressing::OneSided {
             push,
             push_time,
