@@ -11,6 +11,8 @@
 //!   the arm raise, and its range images with landmarks.
 //! - `cargo xtask figures wet [--out DIR]` — Yamada's wet-cloth model against the PARTY step:
 //!   the thesis's timing table re-measured, the largest stable Δt, the shape difference.
+//! - `cargo xtask figures stability [--out DIR]` — the stability map: per solver, Δt × fabric ×
+//!   speed of the held edge → stable / error / non-finite (`stability.md`, `stability.png`).
 //! - `cargo xtask figures fit [--out DIR]` — the string-identification experiments on the
 //!   synthetic objects: Table 1, Fig. 11, Table 3 and the reproduced shapes.
 //! - `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]` — every scenario of
@@ -23,6 +25,7 @@ mod figures_fit;
 mod figures_grid;
 mod figures_grid_body;
 mod figures_solver;
+mod figures_stability;
 mod figures_wet;
 mod plot;
 mod run_scenarios;
@@ -82,6 +85,8 @@ enum FigureSet {
     /// String identification (Sudoh et al.) on the synthetic objects: Table 1, Fig. 11,
     /// Table 3 (about a minute).
     Fit,
+    /// The stability map: Δt × fabric × body speed per solver (a few minutes).
+    Stability,
 }
 
 /// A figure set's entry point: draw everything from the repository root into a folder, return
@@ -103,6 +108,7 @@ fn main() -> Result<()> {
                 FigureSet::Body => ("body", figures_body::draw_all),
                 FigureSet::Wet => ("wet", figures_wet::draw_all),
                 FigureSet::Fit => ("fit", figures_fit::draw_all),
+                FigureSet::Stability => ("stability", figures_stability::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;
