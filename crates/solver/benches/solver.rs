@@ -568,6 +568,16 @@ fn baselines(c: &mut Criterion) {
     write_report("solver_baselines.md", &text);
 }
 
+/// Whether the table `name` is wanted: no criterion filter on the command line, or one that
+/// `name` contains (`cargo bench … -- scaling`).
+fn selected(name: &str) -> bool {
+    let filters: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()))
+}
+
 /// Resident memory of this process, bytes (`/proc/self/statm`; 0 where there is none).
 fn resident_bytes() -> usize {
     std::fs::read_to_string("/proc/self/statm")
@@ -588,6 +598,9 @@ const SCALING_SIDES: [usize; 7] = [17, 32, 71, 100, 158, 224, 317];
 /// slope of log time against log nodes from 10 000 nodes up. `cargo test --benches` runs the
 /// smallest size only.
 fn scaling(_c: &mut Criterion) {
+    if !selected("scaling") {
+        return;
+    }
     let fabric = cotton();
     let sides: &[usize] = if measuring() {
         &SCALING_SIDES
@@ -668,5 +681,107 @@ fn scaling(_c: &mut Criterion) {
     write_report("scaling.md", &table);
 }
 
-criterion_group!(benches, party, baselines, scaling);
+/// The peers' scene (issue 10): a 1 m square sheet of `side × side` nodes pinned at its two
+/// far corners, falling from horizontal for 2 s at Δt 0.01 s with the default step but
+/// `shape_cap` shape iterations per pass (default 30). Returns
+/// the mean wall time per step and the largest axial stretch (l/l⁰ − 1) at the end and over
+/// the run (checked every 0.1 s), or the step's error and when it came.
+fn peer_scene(fabric: &Fabric, side: usize, shape_cap: usize) -> Result<(f64, f64, f64), String> {
+    let grid = StructuredGrid::sheet(side, side, 1.0, 1.0);
+    let topology = ClothTopology::from_structured(&grid).expect("grid");
+    let mut cloth = Cloth::new(topology, fabric, AnisotropyForm::Thesis).expect("cloth");
+    for node in [(side - 1) * side, side * side - 1] {
+        let [x, y] = grid.positions[node];
+        cloth
+            .pin(node as u32, Vector3::new(x, y, 0.0), PinMotion::Fixed)
+            .expect("pin");
+    }
+    let rest = cloth.topology().rest_positions().to_vec();
+    let edges: Vec<(usize, usize, f64)> = cloth
+        .topology()
+        .edges()
+        .iter()
+        .filter(|e| e.kind.is_axial())
+        .map(|e| {
+            let (a, b) = (rest[e.a as usize], rest[e.b as usize]);
+            (e.a as usize, e.b as usize, (a[0] - b[0]).hypot(a[1] - b[1]))
+        })
+        .collect();
+    let stretch = |state: &ClothState| {
+        edges
+            .iter()
+            .map(|&(a, b, l0)| (state.positions[a] - state.positions[b]).norm() / l0 - 1.0)
+            .fold(f64::MIN, f64::max)
+    };
+    let mut state = ClothState::flat(&cloth, 0.0);
+    let params = StepParams {
+        shape_max_iterations: shape_cap,
+        ..StepParams::default()
+    };
+    let mut solver = Solver::new();
+    let (mut wall, mut worst) = (0.0, 0.0f64);
+    let steps = 200;
+    for k in 1..=steps {
+        let t0 = Instant::now();
+        solver
+            .step(&cloth, &mut state, &params)
+            .map_err(|e| format!("step {k}: {e}"))?;
+        wall += t0.elapsed().as_secs_f64();
+        if k % 10 == 0 {
+            worst = worst.max(stretch(&state));
+        }
+    }
+    Ok((wall / steps as f64, stretch(&state), worst))
+}
+
+/// The peers' scene at 50 × 50 and 100 × 100 nodes with 30 (default), 100 and 300 shape
+/// iterations per pass (2 threads); table to stderr and
+/// `$CARGO_TARGET_DIR/atelier-bench/peers.md` (a failed run is a row saying so).
+/// `cargo test --benches` runs the 50 × 50 sheet only.
+fn peers(_c: &mut Criterion) {
+    if !selected("peers") {
+        return;
+    }
+    let fabric = cotton();
+    let cases: &[(usize, usize)] = if measuring() {
+        &[
+            (50, 30),
+            (50, 100),
+            (50, 300),
+            (100, 30),
+            (100, 100),
+            (100, 300),
+        ]
+    } else {
+        &[(50, 30)]
+    };
+    let mut table = String::from(
+        "| sheet | nodes | shape iterations per pass | ms/step (mean of 200) | largest stretch at 2 s | largest stretch over the run |\n|---|---|---|---|---|---|\n",
+    );
+    for &(side, cap) in cases {
+        match peer_scene(&fabric, side, cap) {
+            Ok((per_step, end, worst)) => {
+                let _ = writeln!(
+                    table,
+                    "| {side} × {side} | {} | {cap} | {:.2} | {:.2} % | {:.2} % |",
+                    side * side,
+                    per_step * 1e3,
+                    100.0 * end,
+                    100.0 * worst
+                );
+            }
+            Err(e) => {
+                let _ = writeln!(
+                    table,
+                    "| {side} × {side} | {} | {cap} | failed: {e} | | |",
+                    side * side
+                );
+            }
+        }
+    }
+    eprintln!("{table}");
+    write_report("peers.md", &table);
+}
+
+criterion_group!(benches, party, baselines, scaling, peers);
 criterion_main!(benches);
