@@ -39,8 +39,6 @@ const AMPLITUDE: f64 = 0.05;
 const DURATION: f64 = 1.0;
 const STRAIN_LIMIT: f64 = 0.10;
 
-/// An axial edge: its two nodes and rest length.
-type Edge = (usize, usize, f64);
 /// A case: solver, fabric, speed and time-step indices.
 type Case = (usize, usize, usize, usize);
 
@@ -73,7 +71,7 @@ impl Outcome {
 }
 
 /// The sheet of `fabric` held along its edge y = max by pins moving at peak `speed`.
-fn scene(fabric: &Fabric, speed: f64) -> Result<(Cloth, ClothState, Vec<Edge>)> {
+fn scene(fabric: &Fabric, speed: f64) -> Result<(Cloth, ClothState)> {
     let size = (SIDE - 1) as f64 * SPACING;
     let grid = StructuredGrid::sheet(SIDE, SIDE, size, size);
     let topology = ClothTopology::from_structured(&grid)?;
@@ -90,25 +88,13 @@ fn scene(fabric: &Fabric, speed: f64) -> Result<(Cloth, ClothState, Vec<Edge>)> 
         let [x, y] = grid.positions[node];
         cloth.pin(node as u32, Vector3::new(x, y, 0.0), motion)?;
     }
-    let rest = cloth.topology().rest_positions().to_vec();
-    let edges = cloth
-        .topology()
-        .edges()
-        .iter()
-        .filter(|e| e.kind.is_axial())
-        .map(|e| {
-            let (a, b) = (rest[e.a as usize], rest[e.b as usize]);
-            (e.a as usize, e.b as usize, (a[0] - b[0]).hypot(a[1] - b[1]))
-        })
-        .collect();
     let state = ClothState::flat(&cloth, 0.0);
-    Ok((cloth, state, edges))
+    Ok((cloth, state))
 }
 
-fn largest_strain(state: &ClothState, edges: &[Edge]) -> f64 {
-    edges
-        .iter()
-        .map(|&(a, b, l0)| ((state.positions[a] - state.positions[b]).norm() / l0 - 1.0).abs())
+fn largest_strain(cloth: &Cloth, state: &ClothState) -> f64 {
+    atelier_solver::metrics::axial_strains(cloth, &state.positions)
+        .map(f64::abs)
         .fold(0.0, f64::max)
 }
 
@@ -117,7 +103,7 @@ fn run(solver: &str, fabric: &Fabric, speed: f64, dt: f64) -> Result<(Outcome, f
     if solver == "PARTY" && dt < PARTY_SMALLEST_MS * 1e-3 - 1e-12 {
         return Ok((Outcome::NotRun, f64::NAN));
     }
-    let (cloth, mut state, edges) = scene(fabric, speed)?;
+    let (cloth, mut state) = scene(fabric, speed)?;
     let steps = (DURATION / dt).round() as usize;
     let check_every = ((0.05 / dt).round() as usize).max(1);
     let mut party = Solver::new();
@@ -151,7 +137,7 @@ fn run(solver: &str, fabric: &Fabric, speed: f64, dt: f64) -> Result<(Outcome, f
             return Ok((Outcome::NonFinite, f64::INFINITY));
         }
         if k % check_every == 0 || k == steps {
-            worst = worst.max(largest_strain(&state, &edges));
+            worst = worst.max(largest_strain(&cloth, &state));
         }
     }
     let outcome = if worst > STRAIN_LIMIT {

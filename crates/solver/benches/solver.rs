@@ -696,22 +696,8 @@ fn peer_scene(fabric: &Fabric, side: usize, shape_cap: usize) -> Result<(f64, f6
             .pin(node as u32, Vector3::new(x, y, 0.0), PinMotion::Fixed)
             .expect("pin");
     }
-    let rest = cloth.topology().rest_positions().to_vec();
-    let edges: Vec<(usize, usize, f64)> = cloth
-        .topology()
-        .edges()
-        .iter()
-        .filter(|e| e.kind.is_axial())
-        .map(|e| {
-            let (a, b) = (rest[e.a as usize], rest[e.b as usize]);
-            (e.a as usize, e.b as usize, (a[0] - b[0]).hypot(a[1] - b[1]))
-        })
-        .collect();
     let stretch = |state: &ClothState| {
-        edges
-            .iter()
-            .map(|&(a, b, l0)| (state.positions[a] - state.positions[b]).norm() / l0 - 1.0)
-            .fold(f64::MIN, f64::max)
+        atelier_solver::metrics::axial_strains(&cloth, &state.positions).fold(f64::MIN, f64::max)
     };
     let mut state = ClothState::flat(&cloth, 0.0);
     let params = StepParams {

@@ -300,6 +300,22 @@ pub fn node_count(profile: &[f64], params: &NodeCountParams) -> usize {
     fold_peaks(profile, params).len()
 }
 
+/// The strain `l/l⁰ − 1` of every axial (warp or weft) edge of `cloth` at `positions`, in edge
+/// order: its largest value is the stretch benchmarks and stability checks report.
+pub fn axial_strains<'a>(
+    cloth: &'a crate::Cloth,
+    positions: &'a [Vector3<f64>],
+) -> impl Iterator<Item = f64> + 'a {
+    cloth
+        .topology()
+        .edges()
+        .iter()
+        .filter(|e| e.kind.is_axial())
+        .map(move |e| {
+            (positions[e.a as usize] - positions[e.b as usize]).norm() / e.rest_length - 1.0
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use std::f64::consts::{PI, TAU};
