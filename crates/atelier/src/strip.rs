@@ -10,11 +10,10 @@
 
 use atelier_fabric::{AnisotropyForm, Fabric, Spindle};
 use atelier_fit::cloth::ProfilePoint;
-use atelier_fit::turned::{TurnedProfile, central_differences};
+use atelier_fit::turned::{TurnedProfile, minimise};
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned, Vector3};
+use nalgebra::{DVector, Vector3};
 
 use crate::run::RunError;
 use crate::scenario::StripDirection;
@@ -183,7 +182,6 @@ struct PartyProblem<'a> {
     profiles: &'a [TurnedProfile],
     angles: Vec<f64>,
     run: TurnedRun,
-    p: DVector<f64>,
     runs: std::cell::Cell<usize>,
 }
 
@@ -239,29 +237,6 @@ fn along(line: &[(f64, f64, f64)], s: f64) -> (f64, f64) {
     (0.0, 0.0)
 }
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for PartyProblem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.p.copy_from(x);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.p.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        self.residuals_at(&self.p)
-    }
-
-    /// Central differences in (ln B, ln M₀) with a step of 1e-3.
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        central_differences(&self.p, 1e-3, |p| self.residuals_at(p))
-    }
-}
-
 /// Fit the solver's B and M₀ of `direction` (every other value of `base` kept) so that its
 /// turned strip (`run`) passes nearest the observed profiles; start from `start` (B, M₀) —
 /// the continuum strip's fit (`atelier_fit::turned::fit_turned`) is a good one.
@@ -282,25 +257,27 @@ pub fn fit_turned_party(
         profiles,
         angles,
         run: *run,
-        p: DVector::from_vec(vec![start.0.ln(), start.1.ln()]),
         runs: std::cell::Cell::new(0),
     };
-    let r0 = problem.residuals_at(&problem.p).ok_or_else(|| {
+    let start = DVector::from_vec(vec![start.0.ln(), start.1.ln()]);
+    let r0 = problem.residuals_at(&start).ok_or_else(|| {
         RunError::Setup(format!(
             "turned strip: the solver's strip does not come to rest at the start B {:.3e} N·m, M₀ {:.3e} N",
-            start.0, start.1
+            start[0].exp(),
+            start[1].exp()
         ))
     })?;
     let rows = r0.len() / 2;
-    let (problem, report) = LevenbergMarquardt::new().minimize(problem);
+    // Central differences of 1e-3 in (ln B, ln M₀).
+    let (p, termination) = minimise(start, 1e-3, |p| problem.residuals_at(p));
     let cost = problem
-        .residuals_at(&problem.p)
+        .residuals_at(&p)
         .map_or(f64::NAN, |r| r.norm_squared());
     Ok(PartyHysteresisFit {
-        rigidity: problem.p[0].exp(),
-        residual_moment: problem.p[1].exp(),
+        rigidity: p[0].exp(),
+        residual_moment: p[1].exp(),
         rms: (cost / rows as f64).sqrt(),
         runs: problem.runs.get(),
-        termination: format!("{:?}", report.termination),
+        termination,
     })
 }

@@ -322,7 +322,6 @@ struct Problem<'a> {
     strip: TurnedStrip,
     profiles: &'a [TurnedProfile],
     angles: Vec<f64>,
-    p: DVector<f64>,
     evaluations: std::cell::Cell<usize>,
 }
 
@@ -351,7 +350,17 @@ impl Problem<'_> {
     }
 }
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+/// A least-squares problem given by its residual function; the Jacobian by central
+/// differences.
+struct Differenced<F> {
+    residuals: F,
+    p: DVector<f64>,
+    step: f64,
+}
+
+impl<F: Fn(&DVector<f64>) -> Option<DVector<f64>>> LeastSquaresProblem<f64, Dyn, Dyn>
+    for Differenced<F>
+{
     type ResidualStorage = Owned<f64, Dyn>;
     type JacobianStorage = Owned<f64, Dyn, Dyn>;
     type ParameterStorage = Owned<f64, Dyn>;
@@ -365,22 +374,39 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
-        self.residuals_at(&self.p)
+        (self.residuals)(&self.p)
     }
 
-    /// Central differences in (ln B, ln M₀): the path's reversals make the shapes only
-    /// piecewise smooth in the parameters, and a step of 1e-4 sees through the kinks.
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        central_differences(&self.p, 1e-4, |p| self.residuals_at(p))
+        central_differences(&self.p, self.step, &self.residuals)
     }
+}
+
+/// Levenberg–Marquardt (the `levenberg-marquardt` crate) from `start` on the problem whose
+/// residuals are `residuals`, its Jacobian by central differences of `step` in every parameter
+/// (a forward model whose shapes are only piecewise smooth in the parameters — reversals of a
+/// hysteretic path — needs a step that sees through the kinks): the parameters it ends at and
+/// how it ended.
+pub fn minimise(
+    start: DVector<f64>,
+    step: f64,
+    residuals: impl Fn(&DVector<f64>) -> Option<DVector<f64>>,
+) -> (DVector<f64>, String) {
+    let problem = Differenced {
+        residuals,
+        p: start,
+        step,
+    };
+    let (problem, report) = LevenbergMarquardt::new().minimize(problem);
+    (problem.p, format!("{:?}", report.termination))
 }
 
 /// The Jacobian of `residuals` at `p` by central differences with `step` in every parameter
 /// (None when a residual evaluation fails).
-pub fn central_differences(
+fn central_differences(
     p: &DVector<f64>,
     step: f64,
-    residuals: impl Fn(&DVector<f64>) -> Option<DVector<f64>>,
+    residuals: &impl Fn(&DVector<f64>) -> Option<DVector<f64>>,
 ) -> Option<DMatrix<f64>> {
     let mut columns = Vec::with_capacity(p.len());
     for c in 0..p.len() {
@@ -436,11 +462,10 @@ pub fn fit_turned(
         .collect();
     let elastic = fit_cantilever(&horizontal, length)?;
     let b0 = weight * elastic.bending_length.powi(3);
-    let mut problem = Problem {
+    let problem = Problem {
         strip,
         profiles,
         angles,
-        p: DVector::from_vec(vec![b0.ln(), 0.0]),
         evaluations: std::cell::Cell::new(0),
     };
     let cost = |problem: &Problem, p: &DVector<f64>| {
@@ -464,11 +489,12 @@ pub fn fit_turned(
             "the strip model finds no equilibrium near the elastic estimate",
         ));
     }
-    problem.p[1] = best.1;
-    let (problem, report) = LevenbergMarquardt::new().minimize(problem);
+    // (ln B, ln M₀); a step of 1e-4 sees through the path's kinks.
+    let start = DVector::from_vec(vec![b0.ln(), best.1]);
+    let (p, termination) = minimise(start, 1e-4, |p| problem.residuals_at(p));
     let rows = problem.rows() / 2;
     let rms = |c: f64| (c / rows as f64).sqrt();
-    let fitted_cost = cost(&problem, &problem.p);
+    let fitted_cost = cost(&problem, &p);
     // The best elastic strip (M₀ → 0): a one-dimensional golden search on ln B around b0.
     let elastic_cost = |lnb: f64| {
         let p = DVector::from_vec(vec![lnb, (1e-9 * b0 / length).ln()]);
@@ -490,12 +516,12 @@ pub fn fit_turned(
         }
     }
     Ok(HysteresisFit {
-        rigidity: problem.p[0].exp(),
-        residual_moment: problem.p[1].exp(),
+        rigidity: p[0].exp(),
+        residual_moment: p[1].exp(),
         rms: rms(fitted_cost),
         elastic_rms: rms(fc.min(fd)),
         evaluations: problem.evaluations.get(),
-        termination: format!("{:?}", report.termination),
+        termination,
     })
 }
 
