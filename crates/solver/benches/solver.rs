@@ -683,10 +683,15 @@ fn scaling(_c: &mut Criterion) {
 
 /// The peers' scene (issue 10): a 1 m square sheet of `side × side` nodes pinned at its two
 /// far corners, falling from horizontal for 2 s at Δt 0.01 s with the default step but
-/// `shape_cap` shape iterations per pass (default 30). Returns
-/// the mean wall time per step and the largest axial stretch (l/l⁰ − 1) at the end and over
-/// the run (checked every 0.1 s), or the step's error and when it came.
-fn peer_scene(fabric: &Fabric, side: usize, shape_cap: usize) -> Result<(f64, f64, f64), String> {
+/// `shape_cap` shape iterations per pass (default 30) and long-range attachments on or off.
+/// Returns the mean wall time per step and the largest axial stretch (l/l⁰ − 1) at the end and
+/// over the run (checked every 0.1 s), or the step's error and when it came.
+fn peer_scene(
+    fabric: &Fabric,
+    side: usize,
+    shape_cap: usize,
+    long_range: bool,
+) -> Result<(f64, f64, f64), (String, f64)> {
     let grid = StructuredGrid::sheet(side, side, 1.0, 1.0);
     let topology = ClothTopology::from_structured(&grid).expect("grid");
     let mut cloth = Cloth::new(topology, fabric, AnisotropyForm::Thesis).expect("cloth");
@@ -702,6 +707,7 @@ fn peer_scene(fabric: &Fabric, side: usize, shape_cap: usize) -> Result<(f64, f6
     let mut state = ClothState::flat(&cloth, 0.0);
     let params = StepParams {
         shape_max_iterations: shape_cap,
+        long_range_attachments: long_range,
         ..StepParams::default()
     };
     let mut solver = Solver::new();
@@ -711,7 +717,7 @@ fn peer_scene(fabric: &Fabric, side: usize, shape_cap: usize) -> Result<(f64, f6
         let t0 = Instant::now();
         solver
             .step(&cloth, &mut state, &params)
-            .map_err(|e| format!("step {k}: {e}"))?;
+            .map_err(|e| (format!("step {k}: {e}"), state.time))?;
         wall += t0.elapsed().as_secs_f64();
         if k % 10 == 0 {
             worst = worst.max(stretch(&state));
@@ -720,53 +726,90 @@ fn peer_scene(fabric: &Fabric, side: usize, shape_cap: usize) -> Result<(f64, f6
     Ok((wall / steps as f64, stretch(&state), worst))
 }
 
-/// The peers' scene at 50 × 50 and 100 × 100 nodes with 30 (default), 100 and 300 shape
-/// iterations per pass (2 threads); table to stderr and
-/// `$CARGO_TARGET_DIR/atelier-bench/peers.md` (a failed run is a row saying so).
-/// `cargo test --benches` runs the 50 × 50 sheet only.
+/// The peers' scene at 50 × 50 and 100 × 100 nodes, with the plain shape iterations at 30
+/// (default), 100 and 300 per pass and with long-range attachments at 5, 10 and 30 (2 threads);
+/// table to stderr and `$CARGO_TARGET_DIR/atelier-bench/peers.md`, the rows also as
+/// `peers_party.json` in the peers' schema (`benches/peers/README.md`) for the bench report. A
+/// failed run is a row saying so. `cargo test --benches` runs the 50 × 50 sheet with the
+/// attachments only.
 fn peers(_c: &mut Criterion) {
     if !selected("peers") {
         return;
     }
     let fabric = cotton();
-    let cases: &[(usize, usize)] = if measuring() {
+    let cases: &[(usize, usize, bool)] = if measuring() {
         &[
-            (50, 30),
-            (50, 100),
-            (50, 300),
-            (100, 30),
-            (100, 100),
-            (100, 300),
+            (50, 30, false),
+            (50, 100, false),
+            (50, 300, false),
+            (50, 5, true),
+            (50, 10, true),
+            (50, 30, true),
+            (100, 30, false),
+            (100, 300, false),
+            (100, 5, true),
+            (100, 10, true),
+            (100, 30, true),
         ]
     } else {
-        &[(50, 30)]
+        &[(50, 10, true)]
     };
     let mut table = String::from(
-        "| sheet | nodes | shape iterations per pass | ms/step (mean of 200) | largest stretch at 2 s | largest stretch over the run |\n|---|---|---|---|---|---|\n",
+        "| sheet | nodes | setting | ms/step (mean of 200) | largest stretch at 2 s | largest stretch over the run |\n|---|---|---|---|---|---|\n",
     );
-    for &(side, cap) in cases {
-        match peer_scene(&fabric, side, cap) {
+    let mut rows = Vec::new();
+    for &(side, cap, long_range) in cases {
+        let setting = if long_range {
+            format!("shape_max_iterations={cap}, long_range_attachments")
+        } else if cap == StepParams::default().shape_max_iterations {
+            "defaults".to_string()
+        } else {
+            format!("shape_max_iterations={cap}")
+        };
+        let nodes = side * side;
+        let outcome = peer_scene(&fabric, side, cap, long_range);
+        match &outcome {
             Ok((per_step, end, worst)) => {
                 let _ = writeln!(
                     table,
-                    "| {side} × {side} | {} | {cap} | {:.2} | {:.2} % | {:.2} % |",
-                    side * side,
+                    "| {side} × {side} | {nodes} | {setting} | {:.2} | {:.2} % | {:.2} % |",
                     per_step * 1e3,
                     100.0 * end,
                     100.0 * worst
                 );
             }
-            Err(e) => {
+            Err((e, _)) => {
                 let _ = writeln!(
                     table,
-                    "| {side} × {side} | {} | {cap} | failed: {e} | | |",
-                    side * side
+                    "| {side} × {side} | {nodes} | {setting} | failed: {e} | | |"
                 );
             }
         }
+        let (ms, end, worst, diverged, note) = match outcome {
+            Ok((per_step, end, worst)) => {
+                (Some(per_step * 1e3), Some(end), Some(worst), None, None)
+            }
+            Err((e, t)) => (None, None, None, Some(t), Some(e)),
+        };
+        rows.push(serde_json::json!({
+            "scene": "sheet", "side": side, "nodes": nodes, "setting": setting,
+            "ms_per_step": ms, "stretch_end": end, "stretch_max": worst,
+            "diverged_at_s": diverged, "drape_coefficient": null, "note": note,
+        }));
     }
     eprintln!("{table}");
     write_report("peers.md", &table);
+    let threads = rayon::current_num_threads();
+    let json = serde_json::json!({
+        "peer": "atelier PARTY",
+        "threads": threads,
+        "rows": rows,
+        "differences": [],
+    });
+    write_report(
+        "peers_party.json",
+        &serde_json::to_string_pretty(&json).expect("json"),
+    );
 }
 
 criterion_group!(benches, party, baselines, scaling, peers);

@@ -15,6 +15,7 @@ pub mod cloth;
 pub mod contact;
 pub mod kes;
 pub mod leg;
+pub mod long_range;
 pub mod metrics;
 pub mod params;
 pub mod scenes;

@@ -143,6 +143,12 @@ pub struct StepParams {
     pub bending_deadband: f64,
     /// Skip bending entirely (an inextensible chain or membrane). Default false.
     pub bending_off: bool,
+    /// Long-range attachments ([`crate::long_range`]): hold every free node within its rest
+    /// distance from the pins times (1 + the step's largest target strain) in the shape
+    /// iterations — a bound the converged constraints imply, which carries the corrections of
+    /// a cloth hanging from a few pins across it in one projection. Nothing runs for a cloth
+    /// without pins. Default false (see `docs/solver.md`).
+    pub long_range_attachments: bool,
     /// Divergence guard: a step whose result stretches or shrinks any edge by more than this
     /// strain (|l/l⁰ − 1|) fails with `StepError::Diverged` and keeps the state. Range > 0;
     /// default 1 (a doubled edge: far beyond any fabric's EMT).
@@ -175,6 +181,7 @@ impl Default for StepParams {
             bending_stick_slope: 4.0,
             bending_deadband: 0.05,
             bending_off: false,
+            long_range_attachments: false,
             divergence_strain: 1.0,
             hysteresis: true,
         }

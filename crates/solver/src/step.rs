@@ -266,6 +266,12 @@ struct Scratch {
     reaction: Vec<V3>,
     /// Node pairs held within a distance this step.
     ties: Vec<Tie>,
+    /// The long-range attachments of the cloth's pins (built when the pins change).
+    long_range: Option<crate::long_range::LongRange>,
+    /// Whether `project` applies them this step.
+    long_range_on: bool,
+    /// This step's largest target strain (the attachments' slack).
+    long_range_slack: f64,
     vel: Vec<V3>,
     vel_prev: Vec<V3>,
     vel_hat: Vec<V3>,
@@ -613,6 +619,7 @@ impl Solver {
                 i,
             ));
         }
+        self.prepare_long_range(cloth, params);
         let mut collision_time = Duration::ZERO;
         self.s.pressure_time = Duration::ZERO;
         for pass in 0..params.collision_passes {
@@ -1714,6 +1721,18 @@ impl Solver {
             s.vel[i] = v;
             s.vel_prev[i] = v;
         }
+        if s.long_range_on
+            && let Some(lr) = &s.long_range
+        {
+            lr.project(
+                cloth,
+                &state.positions,
+                &mut s.vel,
+                state.time + dt,
+                dt,
+                s.long_range_slack,
+            );
+        }
         for tie in &s.ties {
             let (a, b) = (tie.a as usize, tie.b as usize);
             let ws = inv[a] + inv[b];
@@ -1741,6 +1760,26 @@ impl Solver {
                 s.vel[i] = plane_push(s.vel[i], &state.positions[i], &s.planes[i], dt);
             }
         }
+    }
+
+    /// Switch the long-range attachments on for this step when asked for and the cloth has pins
+    /// (building them when the pins changed), with the step's largest target strain as slack.
+    fn prepare_long_range(&mut self, cloth: &Cloth, params: &StepParams) {
+        let s = &mut self.s;
+        s.long_range_on = params.long_range_attachments && !cloth.pins().is_empty();
+        if !s.long_range_on {
+            return;
+        }
+        if !s.long_range.as_ref().is_some_and(|lr| lr.matches(cloth)) {
+            s.long_range = Some(crate::long_range::LongRange::build(cloth));
+        }
+        let edges = cloth.topology().edges();
+        s.long_range_slack = s
+            .target
+            .iter()
+            .zip(edges)
+            .map(|(t, e)| t / e.rest_length - 1.0)
+            .fold(0.0, f64::max);
     }
 
     /// One Gauss–Newton step on the shape objective E^e = ½ Σ (l − l_target)² (49): the

@@ -13,6 +13,16 @@ use crate::common::fabric;
 /// A 1 m × 1 m sheet, 2.5 cm grid (41 × 41 nodes), hung from its top edge; returns the state
 /// after `seconds` and the mean internal-force iterations per step over the last second.
 fn hang(method: InternalMethod, seconds: f64, cap: usize) -> (Cloth, ClothState, f64, f64) {
+    hang_with(method, seconds, cap, false)
+}
+
+/// [`hang`], with or without long-range attachments.
+fn hang_with(
+    method: InternalMethod,
+    seconds: f64,
+    cap: usize,
+    long_range: bool,
+) -> (Cloth, ClothState, f64, f64) {
     let f = fabric("cotton_broad");
     let n = 41;
     let topo =
@@ -29,6 +39,7 @@ fn hang(method: InternalMethod, seconds: f64, cap: usize) -> (Cloth, ClothState,
         internal_method: method,
         internal_max_iterations: cap,
         damping: 1.0,
+        long_range_attachments: long_range,
         ..StepParams::default()
     };
     let mut solver = Solver::new();
@@ -99,6 +110,98 @@ fn accelerated_internal_forces_need_fewer_iterations_than_steepest_descent() {
         "hanging sheet, last second: accelerated {fast:.1} iterations/step (E/E₀ {fast_res:.1e}), steepest descent {slow:.1} (E/E₀ {slow_res:.1e})"
     );
     assert!(fast < slow, "accelerated {fast} vs steepest {slow}");
+}
+
+/// The issue-10 peers' scene: a 1 m cotton sheet of `side × side` nodes pinned at the two
+/// corners of one edge, falling from horizontal for `seconds` with the default step (with or
+/// without long-range attachments); the largest axial stretch l/l⁰ − 1 at the end.
+fn corner_pinned(side: usize, seconds: f64, long_range: bool) -> f64 {
+    let f = fabric("cotton_broad");
+    let grid = StructuredGrid::sheet(side, side, 1.0, 1.0);
+    let topo = ClothTopology::from_structured(&grid).expect("grid");
+    let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
+    for node in [(side - 1) * side, side * side - 1] {
+        let [x, y] = grid.positions[node];
+        cloth
+            .pin(node as u32, Vector3::new(x, y, 0.0), PinMotion::Fixed)
+            .expect("pin");
+    }
+    let mut state = ClothState::flat(&cloth, 0.0);
+    let params = StepParams {
+        long_range_attachments: long_range,
+        ..StepParams::default()
+    };
+    let mut solver = Solver::new();
+    for _ in 0..(seconds / params.dt).round() as usize {
+        solver.step(&cloth, &mut state, &params).expect("step");
+    }
+    atelier_solver::metrics::axial_strains(&cloth, &state.positions).fold(f64::MIN, f64::max)
+}
+
+/// A sheet hanging from two corners carries its whole weight through two nodes; with the
+/// default caps the local shape iterations leave it stretched by tens of per cent (measured
+/// 57 % at 50 × 50 after 2 s), the long-range attachments hold it within the issue's goal of 1 %
+/// (measured 0.55 % at 50 × 50; here 31 × 31 after 1.5 s).
+#[test]
+fn a_sheet_pinned_at_two_corners_keeps_its_length_with_long_range_attachments() {
+    let with = corner_pinned(31, 1.5, true);
+    let without = corner_pinned(31, 1.5, false);
+    eprintln!(
+        "corner-pinned 31 × 31 sheet, 1.5 s, default caps: largest stretch {:.2} % with long-range attachments, {:.2} % without",
+        100.0 * with,
+        100.0 * without
+    );
+    assert!(
+        with < 0.01,
+        "stretch {:.2} % with attachments",
+        100.0 * with
+    );
+    assert!(
+        without > 5.0 * with,
+        "attachments made no difference: {without} vs {with}"
+    );
+}
+
+/// The attachments' bound is implied by the converged constraints: the sheet hanging at rest
+/// from its top edge (where the internal forces carry the weight and the constraints are met)
+/// takes the same shape with them, within 0.1 mm.
+#[test]
+fn long_range_attachments_change_no_shape_at_rest() {
+    let (_, without, ..) = hang_with(InternalMethod::Accelerated, 3.0, 30, false);
+    let (_, with, ..) = hang_with(InternalMethod::Accelerated, 3.0, 30, true);
+    let worst = without
+        .positions
+        .iter()
+        .zip(&with.positions)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "edge-hung sheet at rest: largest node distance with/without attachments {worst:.2e} m"
+    );
+    assert!(worst < 1e-4, "the attachments moved a node by {worst} m");
+}
+
+/// A cloth without pins: the attachments have nothing to hold, and the step is bit-identical.
+#[test]
+fn long_range_attachments_without_pins_change_nothing() {
+    let f = fabric("cotton_broad");
+    let grid = StructuredGrid::sheet(11, 11, 0.3, 0.3);
+    let topo = ClothTopology::from_structured(&grid).expect("grid");
+    let cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
+    let run = |long_range| {
+        let mut state = ClothState::flat(&cloth, 0.0);
+        let params = StepParams {
+            long_range_attachments: long_range,
+            gravity: [1.0, 0.0, -9.8],
+            ..StepParams::default()
+        };
+        let mut solver = Solver::new();
+        for _ in 0..20 {
+            solver.step(&cloth, &mut state, &params).expect("step");
+        }
+        state.positions
+    };
+    assert_eq!(run(true), run(false));
 }
 
 /// The stress scene: a 0.5 m sheet (21 × 21 nodes) hanging from its top edge, which oscillates
