@@ -501,6 +501,26 @@ fn garment(
         .frames
         .last()
         .map(|f| f.cloth.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min));
+    let mut warnings = run.warnings;
+    // A garment the body does not hold (too large for it, or a tube with nothing to rest on)
+    // slides off and falls without end (there is no floor): say so instead of drawing it.
+    let below = run.frames.last().map_or(0, |f| {
+        let feet = f.body.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+        let fallen = f
+            .cloth
+            .iter()
+            .filter(|p| p[1] < feet - FALLEN_BELOW_FEET)
+            .count();
+        if fallen > 0 {
+            warnings.push(format!(
+                "{fallen} of {} cloth nodes ended more than {:.0} cm below the body's lowest point (y = {feet:.3} m; lowest node {:.3} m): the body does not hold the garment (too large for it, or nothing to rest on) and it falls",
+                f.cloth.len(),
+                FALLEN_BELOW_FEET * 100.0,
+                lowest.unwrap_or(feet)
+            ));
+        }
+        fallen
+    });
     let mut metrics = BTreeMap::new();
     let mut put = |k: &str, v: Option<f64>| {
         metrics.insert(k.to_string(), v);
@@ -523,6 +543,7 @@ fn garment(
     put("kinetic_energy_j", Some(run.kinetic_energy));
     put("max_motion_kinetic_energy_j", Some(run.max_motion_energy));
     put("lowest_node_m", lowest);
+    put("nodes_below_body", Some(below as f64));
     Ok(Simulated {
         fabric: String::new(),
         cloth_triangles: run.cloth_triangles,
@@ -538,7 +559,7 @@ fn garment(
         wall_seconds: run.wall_seconds,
         timings: run.timings,
         metrics,
-        warnings: run.warnings,
+        warnings,
         failure: run.failure,
         chart: None,
         wet: None,
@@ -546,6 +567,9 @@ fn garment(
         comparison: None,
     })
 }
+
+/// How far below the body's lowest point a garment's node counts as fallen off it, m.
+const FALLEN_BELOW_FEET: f64 = 0.05;
 
 /// A stepping loop shared by the validation scenes: steps `state` until `done` says so (or a
 /// step fails), records a frame every `interval` and keeps the last good positions.

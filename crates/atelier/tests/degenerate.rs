@@ -215,3 +215,62 @@ fn a_scene_too_large_is_refused_when_read() {
         assert_eq!(e.kind, ErrorKind::OutOfRange, "{e}");
     }
 }
+
+/// A garment larger than the scene: a single 3 m × 1 m panel wrapped around the trunk. The
+/// placement widens its wrap so that the panel does not overlap itself (a tube about a metre
+/// across), nothing holds it, and it falls off the body — there is no floor. The run completes,
+/// and the report says what happened (a warning and `nodes_below_body`) instead of drawing it
+/// silently; the sewn dress, which the body holds, has neither.
+#[test]
+fn a_garment_larger_than_the_body_falls_off_and_says_so() {
+    let dir = scratch("larger");
+    std::fs::write(
+        dir.join("wide.ron"),
+        r#"(
+    name: "wide",
+    provenance: "degenerate-geometry test: 3 m wide, 1 m long",
+    grain: ((0.0, -100.0), (0.0, 0.0)),
+    outline: Quad(
+        start: (-150.0, -100.0),
+        bottom: [(name: "bottom", cells: 60, path: [Line(150.0, -100.0)])],
+        right: [(name: "right", cells: 20, path: [Line(150.0, 0.0)])],
+        top: [(name: "top", cells: 60, path: [Line(-150.0, 0.0)])],
+        left: [(name: "left", cells: 20, path: [Line(-150.0, -100.0)])],
+    ),
+)"#,
+    )
+    .expect("write");
+    std::fs::write(
+        dir.join("g.ron"),
+        r#"(name: "wide", provenance: "test", panels: [(name: "wide", pattern: "wide.ron")], seams: [])"#,
+    )
+    .expect("write");
+    let fabric = root().join("fixtures/fabrics/cotton_broad.ron");
+    let scenario = format!(
+        r#"(name: "wide", reproduces: "degenerate-geometry test", kind: Garment(garment: "g.ron", fabric: "{}", placements: [Trunk(facing_deg: 0.0, y0: 0.98)], settings: (dt: 0.01, friction: 0.3, restitution: 0.1, settle: 0.6)))"#,
+        fabric.display()
+    );
+    let path = dir.join("s.ron");
+    std::fs::write(&path, &scenario).expect("write");
+    let s = atelier::scenario::Scenario::load(&path).expect("scenario");
+    let report = atelier::run::run(
+        &s,
+        Some(&path),
+        &dir,
+        &dir.join("out"),
+        &atelier::run::RunOptions::default(),
+        &mut |_| {},
+    )
+    .expect("the run completes");
+    let fallen = report.metrics["nodes_below_body"].expect("metric");
+    assert!(fallen > 0.0, "{:?}", report.metrics);
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("does not hold the garment")),
+        "{:?}",
+        report.warnings
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
