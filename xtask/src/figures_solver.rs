@@ -43,6 +43,7 @@ use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
 use atelier_solver::{
     Cloth, ClothOptions, ClothState, PinMotion, ShapeMethod, Solver, StepError, StepParams,
+    TolerancePolicy,
 };
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -134,6 +135,24 @@ struct Run {
 }
 
 impl Run {
+    /// Drape coefficient at the end: the area inside the outer ring's projection on the
+    /// horizontal plane (shoelace; the ring does not fold over itself in this scene) less the
+    /// support's, over the specimen's less the support's (NaN when the run failed).
+    fn drape_coefficient(&self) -> f64 {
+        use std::f64::consts::PI;
+        self.outcome.as_ref().map_or(f64::NAN, |p| {
+            let ring = &p[(N_RINGS - 1) * N_AROUND..N_RINGS * N_AROUND];
+            let doubled: f64 = (0..N_AROUND)
+                .map(|k| {
+                    let (a, b) = (ring[k], ring[(k + 1) % N_AROUND]);
+                    a[0] * b[1] - b[0] * a[1]
+                })
+                .sum();
+            let support = PI * R_INNER * R_INNER;
+            (0.5 * doubled.abs() - support) / (PI * R_OUTER * R_OUTER - support)
+        })
+    }
+
     /// Lowest node at the end, m (NaN when the run failed).
     fn lowest(&self) -> f64 {
         self.outcome.as_ref().map_or(f64::NAN, |p| {
@@ -342,6 +361,35 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
             ..d()
         };
         c.push(party("shape method", name.to_owned(), p));
+    }
+    for (loose, fast) in [(10.0, 0.5), (100.0, 0.5), (100.0, 0.1)] {
+        let p = StepParams {
+            tolerance_policy: TolerancePolicy::Adaptive {
+                loose_factor: loose,
+                fast_speed: fast,
+                slow_speed: fast / 10.0,
+            },
+            ..d()
+        };
+        c.push(party(
+            "tolerance policy",
+            format!("adaptive ×{loose} above {fast} m/s"),
+            p,
+        ));
+    }
+    // The inner ring is pinned: the long-range attachments apply (the annulus is not convex,
+    // so their rest distances are the shortest paths along the edges).
+    for cap in [10, 30, 60] {
+        let p = StepParams {
+            long_range_attachments: true,
+            shape_max_iterations: cap,
+            ..d()
+        };
+        c.push(party(
+            "long-range attachments",
+            format!("{cap} per pass"),
+            p,
+        ));
     }
     let newton = ShapeMethod::Newton {
         cg_iterations: 100,
@@ -622,12 +670,14 @@ fn table(rows: &[Row], reference: &Run, check: &Run, uncertainty: f64, total: Du
          sweeps). Wall: the stepping loop, fastest of up to {MAX_REPEATS} repeats, one thread. \
          Iterations per step: PARTY's shape iterations over both collision passes and internal \
          iterations over both phases. Max strain (error): PARTY's largest |ε − ε̄| of any step, \
-         the baselines' largest |ε|. The check run took {:.1} s, the whole study {:.0} s.\n",
+         the baselines' largest |ε|. DC: the drape coefficient at 2 s (the reference's: {:.1} %). \
+         The check run took {:.1} s, the whole study {:.0} s.\n",
         reference.wall.as_secs_f64(),
         reference.max_strain,
         reference.lowest() * 1e3,
         2.0 * REFERENCE_DT,
         uncertainty * 1e3,
+        100.0 * reference.drape_coefficient(),
         check.wall.as_secs_f64(),
         total.as_secs_f64(),
     );
@@ -647,13 +697,13 @@ fn table(rows: &[Row], reference: &Run, check: &Run, uncertainty: f64, total: Du
         );
     }
     t.push_str(
-        "| solver | sweep | setting | Δt s | steps | wall ms | error mm | own ref. mm | lowest z mm | iterations/step | max strain (error) | Pareto | status |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| solver | sweep | setting | Δt s | steps | wall ms | error mm | own ref. mm | lowest z mm | DC % | iterations/step | max strain (error) | Pareto | status |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let _ = writeln!(
             t,
-            "| {} | {} | {}{} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {}{} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.family.name(),
             r.sweep,
             r.setting,
@@ -668,6 +718,7 @@ fn table(rows: &[Row], reference: &Run, check: &Run, uncertainty: f64, total: Du
                 mm(r.own_error)
             },
             finite(r.run.lowest() * 1e3, |z| format!("{z:.0}")),
+            finite(r.run.drape_coefficient() * 100.0, |d| format!("{d:.1}")),
             r.run.iterations,
             if r.run.outcome.is_ok() {
                 format!("{:.1e}", r.run.max_strain)
@@ -683,8 +734,10 @@ fn table(rows: &[Row], reference: &Run, check: &Run, uncertainty: f64, total: Du
 
 /// A marker shape per sweep (`k`: the sweep's index within its family), in pixel offsets.
 fn marker<DB: DrawingBackend>(k: usize, style: ShapeStyle) -> DynElement<'static, DB, (i32, i32)> {
-    match k % 7 {
+    match k % 9 {
         0 => Circle::new((0, 0), 5, style).into_dyn(),
+        7 => Rectangle::new([(-3, -3), (3, 3)], style.filled()).into_dyn(),
+        8 => TriangleMarker::new((0, 0), 5, style.filled()).into_dyn(),
         1 => TriangleMarker::new((0, 0), 6, style).into_dyn(),
         2 => Rectangle::new([(-4, -4), (4, 4)], style).into_dyn(),
         3 => Cross::new((0, 0), 5, style).into_dyn(),

@@ -212,6 +212,59 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     }
     let table = out.join("stability.md");
     atelier_fabric::files::write_atomic(&table, md.as_bytes())?;
+    // Summary: per solver and speed, the largest Δt up to which every smaller step run was
+    // stable, over the fabrics (smallest – largest).
+    let mut summary = String::from("| solver |");
+    for speed in SPEEDS {
+        let _ = write!(summary, " stable up to, held edge at {speed} m/s |");
+    }
+    summary.push_str(" outcomes beyond |\n|---|");
+    summary.push_str(&"---|".repeat(SPEEDS.len() + 1));
+    summary.push('\n');
+    for (s, name) in SOLVERS.iter().enumerate() {
+        let _ = write!(summary, "| {name} |");
+        let mut beyond = std::collections::BTreeSet::new();
+        for v in 0..SPEEDS.len() {
+            let limits: Vec<Option<f64>> = (0..FABRICS.len())
+                .map(|f| {
+                    let mut last = None;
+                    for d in 0..STEPS_MS.len() {
+                        match at(s, f, v, d).0 {
+                            Outcome::NotRun => continue,
+                            Outcome::Stable => last = Some(STEPS_MS[d]),
+                            o => {
+                                beyond.insert(o.word());
+                                break;
+                            }
+                        }
+                    }
+                    last
+                })
+                .collect();
+            let text = |x: Option<f64>| x.map_or("none".to_string(), |ms| format!("{ms} ms"));
+            let lo = limits
+                .iter()
+                .copied()
+                .fold(Some(f64::MAX), |a, b| match (a, b) {
+                    (Some(a), Some(b)) => Some(a.min(b)),
+                    _ => None,
+                });
+            let hi = limits
+                .iter()
+                .copied()
+                .flatten()
+                .fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.max(b))));
+            if lo == hi {
+                let _ = write!(summary, " {} |", text(lo));
+            } else {
+                let _ = write!(summary, " {} – {} |", text(lo), text(hi));
+            }
+        }
+        let beyond: Vec<&str> = beyond.into_iter().collect();
+        let _ = writeln!(summary, " {} |", beyond.join(", "));
+    }
+    let summary_path = out.join("stability_summary.md");
+    atelier_fabric::files::write_atomic(&summary_path, summary.as_bytes())?;
     let rows = FABRICS.len() * SPEEDS.len();
     let (cell_w, cell_h, left, top) = (40i32, 22i32, 150i32, 70i32);
     let panel_w = left + cell_w * STEPS_MS.len() as i32 + 30;
@@ -285,5 +338,5 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
         }
         Ok(())
     })?;
-    Ok(vec![table, picture])
+    Ok(vec![table, summary_path, picture])
 }

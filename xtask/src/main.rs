@@ -15,10 +15,14 @@
 //!   speed of the held edge → stable / error / non-finite (`stability.md`, `stability.png`).
 //! - `cargo xtask figures fit [--out DIR]` — the string-identification experiments on the
 //!   synthetic objects: Table 1, Fig. 11, Table 3 and the reproduced shapes.
+//! - `cargo xtask bench-report [--out DIR] [--skip STEP…]` — every criterion bench, the
+//!   time-against-error studies, the stability map, the peers and the benchmark scenarios, then
+//!   `docs/performance.md` regenerated from `xtask/performance.md.in` (about an hour on 2 cores).
 //! - `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]` — every scenario of
 //!   `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on a full run
 //!   `docs/results.md` with its gallery; fails if a scenario fails or misses an expectation.
 
+mod bench_report;
 mod figures_body;
 mod figures_fabric;
 mod figures_fit;
@@ -65,6 +69,17 @@ enum Command {
         /// Run shard I of N (1-based): every N-th scenario by name from the I-th.
         #[arg(long, value_name = "I/N")]
         shard: Option<String>,
+    },
+    /// Run the benches, figures, peers and benchmark scenarios and regenerate
+    /// docs/performance.md from xtask/performance.md.in (about an hour on 2 cores).
+    BenchReport {
+        /// Output folder for the run's figures, peers and scenarios (created if missing);
+        /// default `target/bench-report` in the repository.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Reuse an earlier run's output of these steps instead of running them.
+        #[arg(long, num_args = 1..)]
+        skip: Vec<bench_report::Step>,
     },
 }
 
@@ -128,6 +143,11 @@ fn main() -> Result<()> {
                 eprintln!("some scenarios failed or missed an expectation (see above)");
                 std::process::exit(1);
             }
+        }
+        Command::BenchReport { out, skip } => {
+            let root = repository_root();
+            let out = out.unwrap_or_else(|| root.join("target/bench-report"));
+            bench_report::run(&root, &out, &skip)?;
         }
     }
     Ok(())
