@@ -165,10 +165,10 @@ impl LongRange {
             for &(k, rest) in &self.slots[i][..count] {
                 let c = anchors[k as usize];
                 let d = x - c;
-                let l = d.norm();
                 let bound = rest * scale;
-                if l > bound {
-                    x = c + d * (bound / l);
+                let l2 = d.norm_squared();
+                if l2 > bound * bound {
+                    x = c + d * (bound / l2.sqrt());
                     moved = true;
                 }
             }
