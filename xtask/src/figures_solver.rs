@@ -45,6 +45,7 @@ use atelier_solver::{
     Cloth, ClothOptions, ClothState, PinMotion, ShapeMethod, Solver, StepError, StepParams,
     TolerancePolicy,
 };
+use atelier_solver::metrics::{DEFAULT_SHADOW_ROWS, Shadow, drape_coefficient};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -135,21 +136,16 @@ struct Run {
 }
 
 impl Run {
-    /// Drape coefficient at the end: the area inside the outer ring's projection on the
-    /// horizontal plane (shoelace; the ring does not fold over itself in this scene) less the
-    /// support's, over the specimen's less the support's (NaN when the run failed).
-    fn drape_coefficient(&self) -> f64 {
-        use std::f64::consts::PI;
+    /// Drape coefficient at the end, % (`metrics::drape_coefficient`): the shadow is the union
+    /// of the cloth's projected triangles and the support disk (NaN when the run failed).
+    fn drape_coefficient(&self, cloth: &Cloth) -> f64 {
         self.outcome.as_ref().map_or(f64::NAN, |p| {
-            let ring = &p[(N_RINGS - 1) * N_AROUND..N_RINGS * N_AROUND];
-            let doubled: f64 = (0..N_AROUND)
-                .map(|k| {
-                    let (a, b) = (ring[k], ring[(k + 1) % N_AROUND]);
-                    a[0] * b[1] - b[0] * a[1]
-                })
-                .sum();
-            let support = PI * R_INNER * R_INNER;
-            (0.5 * doubled.abs() - support) / (PI * R_OUTER * R_OUTER - support)
+            let positions: Vec<nalgebra::Vector3<f64>> =
+                p.iter().map(|x| nalgebra::Vector3::new(x[0], x[1], x[2])).collect();
+            let mut shadow = Shadow::new(DEFAULT_SHADOW_ROWS);
+            shadow.add_triangles(&positions, cloth.topology().triangles());
+            shadow.add_disk([0.0, 0.0], R_INNER);
+            drape_coefficient(shadow.area(), R_INNER, R_OUTER)
         })
     }
 
@@ -598,7 +594,14 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     }
     mark_pareto(&mut rows);
 
-    let table = table(&rows, &reference, &check, uncertainty, started.elapsed());
+    let table = table(
+        &cloth,
+        &rows,
+        &reference,
+        &check,
+        uncertainty,
+        started.elapsed(),
+    );
     std::io::stdout().write_all(table.as_bytes())?;
     let md = out.join("time_vs_error.md");
     write_atomically(&md, &table)?;
@@ -653,7 +656,14 @@ fn mm(x: Option<f64>) -> String {
     x.map_or("–".to_owned(), |e| format!("{:.1}", e * 1e3))
 }
 
-fn table(rows: &[Row], reference: &Run, check: &Run, uncertainty: f64, total: Duration) -> String {
+fn table(
+    cloth: &Cloth,
+    rows: &[Row],
+    reference: &Run,
+    check: &Run,
+    uncertainty: f64,
+    total: Duration,
+) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,
@@ -677,7 +687,7 @@ fn table(rows: &[Row], reference: &Run, check: &Run, uncertainty: f64, total: Du
         reference.lowest() * 1e3,
         2.0 * REFERENCE_DT,
         uncertainty * 1e3,
-        100.0 * reference.drape_coefficient(),
+        reference.drape_coefficient(cloth),
         check.wall.as_secs_f64(),
         total.as_secs_f64(),
     );
@@ -718,7 +728,7 @@ fn table(rows: &[Row], reference: &Run, check: &Run, uncertainty: f64, total: Du
                 mm(r.own_error)
             },
             finite(r.run.lowest() * 1e3, |z| format!("{z:.0}")),
-            finite(r.run.drape_coefficient() * 100.0, |d| format!("{d:.1}")),
+            finite(r.run.drape_coefficient(cloth), |d| format!("{d:.1}")),
             r.run.iterations,
             if r.run.outcome.is_ok() {
                 format!("{:.1e}", r.run.max_strain)
