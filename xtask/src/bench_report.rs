@@ -322,16 +322,14 @@ fn machine(root: &Path) -> String {
     let command = |program: &str, args: &[&str]| {
         Command::new(program)
             .args(args)
-            .current_dir(root)
             .output()
             .ok()
             .filter(|o| o.status.success())
             .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
             .unwrap_or_else(|| "unknown".into())
     };
-    let dirty = !command("git", &["status", "--porcelain", "--untracked-files=no"]).is_empty();
     format!(
-        "| | |\n|---|---|\n| CPU | {} ({} logical cores available to this process; {} per package) |\n| caches (per core unless shared) | {} |\n| memory | {} |\n| system | {} |\n| compiler | {} (bench profile: opt-level 3) |\n| commit | `{}`{} |\n| date | {} |",
+        "| | |\n|---|---|\n| CPU | {} ({} logical cores available to this process; {} per package) |\n| caches (per core unless shared) | {} |\n| memory | {} |\n| system | {} |\n| compiler | {} (bench profile: opt-level 3) |\n| commit | {} |\n| date | {} |",
         field("model name"),
         cores,
         field("siblings"),
@@ -343,12 +341,7 @@ fn machine(root: &Path) -> String {
         memory,
         command("uname", &["-sr"]),
         command("rustc", &["-V"]),
-        command("git", &["rev-parse", "--short", "HEAD"]),
-        if dirty {
-            " with uncommitted changes"
-        } else {
-            ""
-        },
+        crate::run_scenarios::commit(root),
         command("date", &["-u", "+%Y-%m-%d %H:%M UTC"]),
     )
 }

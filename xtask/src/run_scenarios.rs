@@ -420,7 +420,7 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
 
 /// The repository's commit, marked when tracked files had uncommitted changes (the results
 /// then come from code no commit holds).
-fn commit(root: &Path) -> String {
+pub(crate) fn commit(root: &Path) -> String {
     let git = |args: &[&str]| {
         std::process::Command::new("git")
             .args(args)
