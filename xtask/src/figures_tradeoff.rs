@@ -17,7 +17,7 @@
 //! tighter run (Δt 1.25 ms, caps doubled), reported in the table and drawn on the figure.
 //!
 //! Writes `tradeoff_<scene>.md` and `tradeoff_<scene>.png` into the output folder, each
-//! atomically (a temporary name, then a rename). The full set takes about 15 minutes on two
+//! atomically (a temporary name, then a rename). The full set takes about 8 minutes on two
 //! cores; `quick` runs a smoke subset (shorter, coarser reference, three runs).
 
 use std::path::{Path, PathBuf};

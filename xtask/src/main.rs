@@ -15,7 +15,7 @@
 //!   speed of the held edge → stable / error / non-finite (`stability.md`, `stability.png`).
 //! - `cargo xtask figures tradeoff [--out DIR]` — time against error for the sewn dress and the
 //!   walk: PARTY's accuracy knobs swept, XPBD and mass-spring, against a tight PARTY reference
-//!   (`tradeoff_dress.{md,png}`, `tradeoff_walk.{md,png}`, about 15 minutes).
+//!   (`tradeoff_dress.{md,png}`, `tradeoff_walk.{md,png}`, about 8 minutes).
 //! - `cargo xtask figures fit [--out DIR]` — the string-identification experiments on the
 //!   synthetic objects: Table 1, Fig. 11, Table 3 and the reproduced shapes.
 //! - `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]` — every scenario of
@@ -92,7 +92,7 @@ enum FigureSet {
     /// The stability map: Δt × fabric × body speed per solver (a few minutes).
     Stability,
     /// Time against error for the sewn dress and the walk: PARTY's knobs swept, XPBD and
-    /// mass-spring, against a tight PARTY reference (about 15 minutes).
+    /// mass-spring, against a tight PARTY reference (about 8 minutes).
     Tradeoff,
 }
 
