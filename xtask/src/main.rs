@@ -13,6 +13,9 @@
 //!   the thesis's timing table re-measured, the largest stable Δt, the shape difference.
 //! - `cargo xtask figures stability [--out DIR]` — the stability map: per solver, Δt × fabric ×
 //!   speed of the held edge → stable / error / non-finite (`stability.md`, `stability.png`).
+//! - `cargo xtask figures tradeoff [--out DIR]` — time against error for the sewn dress and the
+//!   walk: PARTY's accuracy knobs swept, XPBD and mass-spring, against a tight PARTY reference
+//!   (`tradeoff_dress.{md,png}`, `tradeoff_walk.{md,png}`, about 8 minutes).
 //! - `cargo xtask figures fit [--out DIR]` — the string-identification experiments on the
 //!   synthetic objects: Table 1, Fig. 11, Table 3 and the reproduced shapes.
 //! - `cargo xtask bench-report [--out DIR] [--skip STEP…]` — every criterion bench, the
@@ -30,6 +33,7 @@ mod figures_grid;
 mod figures_grid_body;
 mod figures_solver;
 mod figures_stability;
+mod figures_tradeoff;
 mod figures_wet;
 mod plot;
 mod run_scenarios;
@@ -102,6 +106,9 @@ enum FigureSet {
     Fit,
     /// The stability map: Δt × fabric × body speed per solver (a few minutes).
     Stability,
+    /// Time against error for the sewn dress and the walk: PARTY's knobs swept, XPBD and
+    /// mass-spring, against a tight PARTY reference (about 8 minutes).
+    Tradeoff,
 }
 
 /// A figure set's entry point: draw everything from the repository root into a folder, return
@@ -124,6 +131,7 @@ fn main() -> Result<()> {
                 FigureSet::Wet => ("wet", figures_wet::draw_all),
                 FigureSet::Fit => ("fit", figures_fit::draw_all),
                 FigureSet::Stability => ("stability", figures_stability::draw_all),
+                FigureSet::Tradeoff => ("tradeoff", figures_tradeoff::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;

@@ -23,6 +23,6 @@ pub mod validate;
 pub mod wet;
 
 pub use assemble::{AssembleError, GarmentCloth};
-pub use scene::{Garment, GarmentSpec, Scene, SceneError, Settings};
+pub use scene::{ClothSolver, Garment, GarmentSpec, Scene, SceneError, Settings};
 pub use sewing::{Chain, Sewing, SewingParams};
 pub use simulation::{Phase, Simulation, SimulationError, StepOutcome};

@@ -15,6 +15,7 @@ use atelier_fabric::{AnisotropyForm, ErrorKind, Fabric, InvalidValue, STANDARD_G
 use atelier_grid::ImproveParams;
 use atelier_grid::pattern::load_garment;
 use atelier_solver::StepParams;
+use atelier_solver::baselines::{MassSpringParams, XpbdParams};
 use serde::{Deserialize, Serialize};
 
 use crate::place::{PlaceParams, Placement};
@@ -68,6 +69,37 @@ pub enum Dressing {
     },
 }
 
+/// The cloth solver that steps a garment. The seams and the body reach every solver through the
+/// same collision hook (`atelier_solver::baselines`, "Collisions and seams").
+///
+/// In a scenario file: `solver: Party` (the default), `solver: Xpbd((substeps: 10, iterations:
+/// 4))`, `solver: MassSpring((substeps: 100))`. A baseline's `dt` and `gravity` are the scene's
+/// (`settings.dt`; gravity off while sewing): the baseline's `dt` field is ignored, its substeps
+/// divide the scene's Δt. The mass-spring model is explicit: its substep Δt/substeps must lie
+/// below its stability limit (about 1.2·10⁻⁴ s for cotton on the dress's 2 cm grid).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ClothSolver {
+    /// The PARTY step (thesis §3.5, §3.8) with `settings.step`.
+    #[default]
+    Party,
+    /// The XPBD baseline (distance constraints from the fabric's secant stiffness).
+    Xpbd(XpbdParams),
+    /// The explicit mass-spring baseline (Yamada's model, Verlet).
+    MassSpring(MassSpringParams),
+}
+
+impl ClothSolver {
+    /// A short name (reports, figures).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Party => "PARTY",
+            Self::Xpbd(_) => "XPBD",
+            Self::MassSpring(_) => "mass-spring",
+        }
+    }
+}
+
 /// The physics of a garment scene and its schedule: sew (or push), settle, move.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -109,6 +141,10 @@ pub struct Settings {
     /// solver's defaults (diagonals held at the targets of the fabric's shear characteristic,
     /// as in the thesis).
     pub step: StepParams,
+    /// The cloth solver. Default `Party` (the thesis's; `step` then applies). The baselines
+    /// take their own parameters and ignore `step`; one-sided dressing needs `Party` (its push
+    /// is an external force only the PARTY step takes).
+    pub solver: ClothSolver,
 }
 
 impl Default for Settings {
@@ -128,6 +164,7 @@ impl Default for Settings {
             motion_time: 0.0,
             frame_interval: 0.04,
             step: StepParams::default(),
+            solver: ClothSolver::Party,
         }
     }
 }
@@ -283,7 +320,40 @@ impl Settings {
                 format!("settings.step.{}", e.name),
                 e.to_string(),
             )
-        })
+        })?;
+        let baseline = match &self.solver {
+            ClothSolver::Party => Ok(()),
+            ClothSolver::Xpbd(p) => XpbdParams {
+                dt: self.dt,
+                gravity: self.gravity,
+                ..p.clone()
+            }
+            .validate(),
+            ClothSolver::MassSpring(p) => MassSpringParams {
+                dt: self.dt,
+                gravity: self.gravity,
+                ..p.clone()
+            }
+            .validate(),
+        };
+        baseline.map_err(|e| {
+            InvalidValue::new(
+                ErrorKind::OutOfRange,
+                format!("settings.solver.{}", e.name),
+                e.to_string(),
+            )
+        })?;
+        if self.solver != ClothSolver::Party && matches!(self.dressing, Dressing::OneSided { .. }) {
+            return Err(InvalidValue::new(
+                ErrorKind::Inconsistent,
+                "settings.solver",
+                format!(
+                    "{}: one-sided dressing pushes the garment with an external force, which only the Party solver takes",
+                    self.solver.name()
+                ),
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -450,5 +520,67 @@ mod tests {
         };
         assert_eq!(bad.check().expect_err("NaN").kind, ErrorKind::NotFinite);
         assert!(Settings::default().check().is_ok());
+    }
+
+    #[test]
+    fn a_baseline_solver_is_checked_with_the_field_named() {
+        let bad = Settings {
+            solver: ClothSolver::Xpbd(XpbdParams {
+                substeps: 0,
+                ..XpbdParams::default()
+            }),
+            ..Settings::default()
+        };
+        let e = bad.check().expect_err("no substeps");
+        assert_eq!(e.field, "settings.solver.substeps");
+        assert_eq!(e.kind, ErrorKind::OutOfRange);
+        let bad = Settings {
+            solver: ClothSolver::MassSpring(MassSpringParams {
+                damping: -1.0,
+                ..MassSpringParams::default()
+            }),
+            ..Settings::default()
+        };
+        assert_eq!(
+            bad.check().expect_err("damping").field,
+            "settings.solver.damping"
+        );
+        // The baseline's own Δt is replaced by the scene's: a baseline dt out of range is not
+        // an error, the scene's is.
+        let ok = Settings {
+            solver: ClothSolver::Xpbd(XpbdParams {
+                dt: 5.0,
+                ..XpbdParams::default()
+            }),
+            ..Settings::default()
+        };
+        assert!(ok.check().is_ok());
+        let bad = Settings {
+            solver: ClothSolver::Xpbd(XpbdParams::default()),
+            dressing: Dressing::OneSided {
+                push: 2.0,
+                push_time: 0.5,
+                push_limit: 2.0,
+            },
+            ..Settings::default()
+        };
+        let e = bad.check().expect_err("one-sided");
+        assert_eq!(
+            (e.field.as_str(), e.kind),
+            ("settings.solver", ErrorKind::Inconsistent)
+        );
+        // The default is PARTY, and a settings block without `solver` still parses to it.
+        let parsed: Settings = ron::from_str("(dt: 0.01, settle: 0.5)").expect("parses");
+        assert_eq!(parsed.solver, ClothSolver::Party);
+        let parsed: Settings =
+            ron::from_str("(solver: Xpbd((substeps: 5, iterations: 2)))").expect("parses");
+        assert_eq!(
+            parsed.solver,
+            ClothSolver::Xpbd(XpbdParams {
+                substeps: 5,
+                iterations: 2,
+                ..XpbdParams::default()
+            })
+        );
     }
 }

@@ -24,6 +24,7 @@ use atelier_body::model::LabelledMesh;
 use atelier_body::motion::PoseRate;
 use atelier_collide::parts::Motion as PartMotion;
 use atelier_collide::{ContactMaterial, ContactParams, RigidParts, V3};
+use atelier_solver::baselines::{BaselineReport, MassSpring, MassSpringParams, Xpbd, XpbdParams};
 use atelier_solver::{
     BodyContact, ClothState, Solver, StageTimings, StepError, StepParams, StepReport,
 };
@@ -31,7 +32,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::place::place;
-use crate::scene::{Dressing, Scene, SceneError};
+use crate::scene::{ClothSolver, Dressing, Scene, SceneError};
 use crate::{Chain, Sewing};
 
 /// The phase of the dressing schedule a step belongs to.
@@ -121,11 +122,45 @@ pub struct StepOutcome {
     pub contacts: atelier_collide::PassStats,
 }
 
+/// A baseline solver stepping the garment instead of PARTY (`settings.solver`), with its
+/// parameters (Δt the scene's, gravity as the schedule says).
+enum Baseline {
+    /// PARTY: `Simulation::solver` with `Simulation::params`.
+    None,
+    Xpbd(Box<Xpbd>, XpbdParams),
+    MassSpring(Box<MassSpring>, MassSpringParams),
+}
+
+impl Baseline {
+    fn set_gravity(&mut self, g: [f64; 3]) {
+        match self {
+            Self::None => {}
+            Self::Xpbd(_, p) => p.gravity = g,
+            Self::MassSpring(_, p) => p.gravity = g,
+        }
+    }
+}
+
+/// A baseline's diagnostics in the PARTY step's report: its sweeps as shape iterations, its
+/// largest strain |l/l⁰ − 1| as the strain error (a baseline's springs rest at l⁰), its timings.
+fn baseline_step_report(r: BaselineReport) -> StepReport {
+    StepReport {
+        shape_iterations: r.iterations,
+        max_strain_error: r.max_strain,
+        kinetic_energy: r.kinetic_energy,
+        max_speed: r.max_speed,
+        tolerance_factor: 1.0,
+        timings: r.timings,
+        ..StepReport::default()
+    }
+}
+
 /// A garment scene being simulated.
 pub struct Simulation {
     scene: Scene,
     state: ClothState,
     solver: Solver,
+    baseline: Baseline,
     sewing: Sewing,
     contact: BodyContact,
     params: StepParams,
@@ -256,9 +291,29 @@ impl Simulation {
             gravity: [0.0; 3],
             ..settings.step.clone()
         };
+        let baseline = match &settings.solver {
+            ClothSolver::Party => Baseline::None,
+            ClothSolver::Xpbd(p) => Baseline::Xpbd(
+                Box::new(Xpbd::new()),
+                XpbdParams {
+                    dt: settings.dt,
+                    gravity: [0.0; 3],
+                    ..p.clone()
+                },
+            ),
+            ClothSolver::MassSpring(p) => Baseline::MassSpring(
+                Box::new(MassSpring::new()),
+                MassSpringParams {
+                    dt: settings.dt,
+                    gravity: [0.0; 3],
+                    ..p.clone()
+                },
+            ),
+        };
         Ok(Self {
             state,
             solver: Solver::new(),
+            baseline,
             sewing,
             contact,
             params,
@@ -419,6 +474,7 @@ impl Simulation {
     fn start_settling(&mut self) {
         self.phase = Phase::Settling;
         self.params.gravity = self.scene.settings.gravity;
+        self.baseline.set_gravity(self.scene.settings.gravity);
         if self.scene.settings.self_collision {
             self.contact.set_self_collision(true);
         }
@@ -469,12 +525,19 @@ impl Simulation {
         self.start_positions.clone_from(&self.state.positions);
         let report = {
             let mut hooks = Chain(vec![&mut self.sewing, &mut self.contact]);
-            self.solver.step_with(
-                &self.scene.garment.cloth.cloth,
-                &mut self.state,
-                &self.params,
-                &mut hooks,
-            )
+            let cloth = &self.scene.garment.cloth.cloth;
+            match &mut self.baseline {
+                Baseline::None => {
+                    self.solver
+                        .step_with(cloth, &mut self.state, &self.params, &mut hooks)
+                }
+                Baseline::Xpbd(solver, p) => solver
+                    .step_with(cloth, &mut self.state, p, &mut hooks)
+                    .map(baseline_step_report),
+                Baseline::MassSpring(solver, p) => solver
+                    .step_with(cloth, &mut self.state, p, &mut hooks)
+                    .map(baseline_step_report),
+            }
         }
         .map_err(|e| SimulationError {
             phase: self.phase,

@@ -47,7 +47,7 @@ fn wet(c: &mut Criterion) {
     let mut ys: ClothState = start.clone();
     for _ in 0..3600 {
         yamada
-            .step_with(&cloth, &mut ys, &params, &mut extras)
+            .step_with_extras(&cloth, &mut ys, &params, &mut extras)
             .expect("yamada warm-up");
     }
 
@@ -85,7 +85,7 @@ fn wet(c: &mut Criterion) {
     g.bench_function("yamada_step", |b| {
         b.iter(|| {
             yamada
-                .step_with(&cloth, &mut ys, &params, &mut extras)
+                .step_with_extras(&cloth, &mut ys, &params, &mut extras)
                 .expect("yamada step")
         });
     });

@@ -367,7 +367,7 @@ fn regularised(s: &atelier_fabric::Spindle, stick: f64, band: f64) -> atelier_fa
 /// A node's velocity such that it ends the step in front of `plane`: pushed out along the
 /// normal, and Coulomb friction taking up to ρ times that change off its velocity relative to
 /// the body, along the plane.
-fn plane_push(v: V3, x: &V3, plane: &atelier_collide::ContactPlane, dt: f64) -> V3 {
+pub(crate) fn plane_push(v: V3, x: &V3, plane: &atelier_collide::ContactPlane, dt: f64) -> V3 {
     let d = (x + v * dt - plane.point).dot(&plane.normal);
     if d >= 0.0 {
         return v;

@@ -9,8 +9,14 @@
 //! isometric bending hinges described in [`crate::baselines`] (off by default: Yamada's model
 //! has no bending). Spring stiffness from the fabric: `k = W·E/l⁰`, see [`crate::baselines`].
 //! Contact, friction and air pressure (Y3.2)–(Y3.10) are not part of the baseline itself; a scene
-//! adds them through [`SpringExtras`] ([`MassSpring::step_with`]; the wet cloth of
-//! [`crate::wet`]).
+//! adds them through [`SpringExtras`] ([`MassSpring::step_with_extras`]; the wet cloth of
+//! [`crate::wet`]), or through the PARTY step's [`CollisionHook`] ([`MassSpring::step_with`]:
+//! the garment pipeline's seams and body contact, see [`crate::baselines`]).
+//!
+//! Substeps ([`MassSpringParams::substeps`], default 1): a step of length Δt is `substeps`
+//! Verlet steps of Δt/substeps, so that a scene stepping at Δt = 0.01 s (the garment pipeline,
+//! whose body is posed and whose hooks run once per step) can run the explicit model at the
+//! 10⁻⁴ s it needs. With one substep the step is exactly the model above.
 //!
 //! Time stepping. The positions of the previous step are kept in the solver (position Verlet
 //! needs `P_{t−1}`); the velocity written back is `(P_{t+1} − P_t)/Δt`, the mid-step velocity.
@@ -24,14 +30,16 @@
 
 use serde::{Deserialize, Serialize};
 
+use std::time::Instant;
+
 use super::{
-    BaselineReport, Hinge, V3, check_input, fill_hinges, fill_stiffness, first_non_finite,
-    non_finite, report, resize,
+    BaselineReport, Hinge, HookState, V3, check_input, fill_hinges, fill_stiffness,
+    first_non_finite, non_finite, report, resize,
 };
 use crate::cloth::Cloth;
 use crate::params::{ParamError, check, check_motion};
 use crate::state::ClothState;
-use crate::step::{Stage, StepError};
+use crate::step::{CollisionHook, NoCollision, Stage, StageTimings, StepError};
 
 /// Parameters of the mass-spring baseline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -56,6 +64,9 @@ pub struct MassSpringParams {
     /// above 0; default 10 (Yamada's soft springs legitimately reach strains of 2–3 under a
     /// vacuum; a spring eleven times its length has diverged).
     pub divergence_strain: f64,
+    /// Verlet steps per step (each of Δt/substeps; the stability limit applies to that).
+    /// Range [1, 100000]; default 1.
+    pub substeps: usize,
 }
 
 impl Default for MassSpringParams {
@@ -67,6 +78,7 @@ impl Default for MassSpringParams {
             reference_force_fraction: 0.01,
             bending: false,
             divergence_strain: 10.0,
+            substeps: 1,
         }
     }
 }
@@ -86,7 +98,18 @@ impl MassSpringParams {
             self.divergence_strain,
             self.divergence_strain > 0.0,
             "> 0",
+        )?;
+        check(
+            "substeps",
+            self.substeps as f64,
+            (1..=100_000).contains(&self.substeps),
+            "[1, 100000]",
         )
+    }
+
+    /// The length of one Verlet step, Δt/substeps, s.
+    pub fn substep(&self) -> f64 {
+        self.dt / self.substeps as f64
     }
 
     /// Gravity as a vector.
@@ -95,7 +118,9 @@ impl MassSpringParams {
     }
 }
 
-/// Forces and contacts a scene adds to the mass-spring step ([`MassSpring::step_with`]).
+/// Forces and contacts a scene adds to the mass-spring step ([`MassSpring::step_with_extras`]).
+/// With substeps, both are called in every substep with the substep's length and the state at
+/// its start.
 pub trait SpringExtras {
     /// Add forces at the start of the step, after the springs, gravity and damping (`forces`
     /// holds their sum; an extra that depends on the total, such as a normal force, sees it).
@@ -131,6 +156,20 @@ pub struct MassSpring {
     force: Vec<V3>,
     next: Vec<V3>,
     velocity: Vec<V3>,
+    previous: Vec<V3>,
+    history: Option<History>,
+    /// The collision hook's ties, planes and exit velocities over a step.
+    hook: HookState,
+    /// The state before the step (restored on error) when it has several substeps or a hook.
+    backup: Option<Backup>,
+}
+
+/// What a step with substeps changes before it can fail.
+#[derive(Clone, Debug, Default)]
+struct Backup {
+    positions: Vec<V3>,
+    velocities: Vec<V3>,
+    time: f64,
     previous: Vec<V3>,
     history: Option<History>,
 }
@@ -170,22 +209,190 @@ impl MassSpring {
         state: &mut ClothState,
         params: &MassSpringParams,
     ) -> Result<BaselineReport, StepError> {
-        self.step_with(cloth, state, params, &mut NoExtras)
+        self.step_full(cloth, state, params, &mut NoExtras, &mut NoCollision)
     }
 
     /// One step with a scene's extra forces and contacts. On error the state is unchanged.
-    pub fn step_with(
+    pub fn step_with_extras(
         &mut self,
         cloth: &Cloth,
         state: &mut ClothState,
         params: &MassSpringParams,
         extras: &mut dyn SpringExtras,
     ) -> Result<BaselineReport, StepError> {
+        self.step_full(cloth, state, params, extras, &mut NoCollision)
+    }
+
+    /// One step with a collision hook, as the PARTY step drives it ([`crate::baselines`],
+    /// "Collisions and seams"): `transfer` once before the substeps with the step's Δt (a
+    /// velocity change it makes enters the Verlet recursion), its ties and contact planes
+    /// applied as position corrections after the Verlet update of every substep, `resolve`
+    /// once after the last. On error the state is unchanged.
+    pub fn step_with(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &MassSpringParams,
+        hook: &mut dyn CollisionHook,
+    ) -> Result<BaselineReport, StepError> {
+        self.step_full(cloth, state, params, &mut NoExtras, hook)
+    }
+
+    fn step_full(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &MassSpringParams,
+        extras: &mut dyn SpringExtras,
+        hook: &mut dyn CollisionHook,
+    ) -> Result<BaselineReport, StepError> {
+        let t_start = Instant::now();
         params.validate()?;
         check_input(cloth, state)?;
+        let time = state.time;
+        let h = params.substep();
+        let mut backup = self.backup.take().unwrap_or_default();
+        backup.positions.clone_from(&state.positions);
+        backup.velocities.clone_from(&state.velocities);
+        backup.time = time;
+        backup.previous.clone_from(&self.previous);
+        backup.history = self.history;
+        let result = self.substeps(cloth, state, params, extras, hook, &backup, h);
+        let out = match result {
+            Ok(mut timings) => {
+                let tu = Instant::now();
+                let mut r = report(cloth, state, params.substeps);
+                timings.update += tu.elapsed();
+                timings.velocity = t_start.elapsed().saturating_sub(
+                    timings.transfer + timings.shape + timings.collision + timings.update,
+                );
+                r.timings = timings;
+                Ok(r)
+            }
+            Err(e) => {
+                state.positions.copy_from_slice(&backup.positions);
+                state.velocities.copy_from_slice(&backup.velocities);
+                state.time = backup.time;
+                self.previous.clone_from(&backup.previous);
+                self.history = backup.history;
+                Err(e)
+            }
+        };
+        self.backup = Some(backup);
+        out
+    }
+
+    /// The hook's transfer, the substeps with the ties and planes, the hook's resolve; the
+    /// state changes as it goes (the caller restores it on error).
+    #[allow(clippy::too_many_arguments)]
+    fn substeps(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &MassSpringParams,
+        extras: &mut dyn SpringExtras,
+        hook: &mut dyn CollisionHook,
+        start: &Backup,
+        h: f64,
+    ) -> Result<StageTimings, StepError> {
+        let mut timings = StageTimings::default();
+        let (dt, time) = (params.dt, state.time);
+        let n = cloth.topology().node_count();
+        let inv = cloth.inverse_masses();
+
+        // The hook's transfer, at the start of the step: a velocity change is also a change of
+        // the previous position the Verlet recursion continues from.
+        let tc = Instant::now();
+        let continuing = self.history
+            == Some(History {
+                time: time.to_bits(),
+                dt: h.to_bits(),
+            })
+            && self.previous.len() == n;
+        resize(&mut self.velocity, n, V3::zeros());
+        self.velocity.copy_from_slice(&state.velocities);
+        self.hook
+            .transfer(hook, cloth, &state.positions, &mut self.velocity, dt, time);
+        if let Some(i) = first_non_finite(&self.velocity) {
+            return Err(non_finite(Stage::Collision, "velocity", "node", i, time));
+        }
+        for i in 0..n {
+            let (after, before) = (self.velocity[i], state.velocities[i]);
+            if after != before {
+                if continuing {
+                    self.previous[i] -= (after - before) * h;
+                }
+                state.velocities[i] = after;
+            }
+        }
+        timings.transfer = tc.elapsed();
+
+        for k in 0..params.substeps {
+            let frac = (k + 1) as f64 / params.substeps as f64;
+            self.verlet(
+                cloth,
+                state,
+                params,
+                extras,
+                h,
+                frac,
+                dt * (1.0 - frac),
+                &mut timings,
+            )?;
+        }
+        if params.substeps > 1 {
+            // The substeps' times summed to time + Δt up to rounding: the step ends at it.
+            state.time = time + dt;
+            self.history = Some(History {
+                time: state.time.to_bits(),
+                dt: h.to_bits(),
+            });
+        }
+
+        // The hook's collision pass over the whole step.
+        let tc = Instant::now();
+        if let Some(dv) = self.hook.resolve(
+            hook,
+            cloth,
+            &start.positions,
+            &mut state.positions,
+            dt,
+            time,
+        ) {
+            for i in 0..n {
+                if dv[i] != V3::zeros() && inv[i] > 0.0 {
+                    state.velocities[i] += dv[i];
+                    // The recursion continues with the new velocity.
+                    self.previous[i] = state.positions[i] - state.velocities[i] * h;
+                }
+            }
+        }
+        if let Some(i) =
+            first_non_finite(&state.positions).or_else(|| first_non_finite(&state.velocities))
+        {
+            return Err(non_finite(Stage::Collision, "velocity", "node", i, time));
+        }
+        timings.collision = tc.elapsed();
+        Ok(timings)
+    }
+
+    /// One Verlet step of length `h` from the state, committed into it; then the hook's ties
+    /// and planes (`frac` of the step done, `t_left` to its end).
+    #[allow(clippy::too_many_arguments)]
+    fn verlet(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &MassSpringParams,
+        extras: &mut dyn SpringExtras,
+        h: f64,
+        frac: f64,
+        t_left: f64,
+        timings: &mut StageTimings,
+    ) -> Result<(), StepError> {
         let topo = cloth.topology();
         let n = topo.node_count();
-        let (dt, time) = (params.dt, state.time);
+        let (dt, time) = (h, state.time);
         resize(&mut self.force, n, V3::zeros());
         resize(&mut self.next, n, V3::zeros());
         resize(&mut self.velocity, n, V3::zeros());
@@ -275,6 +482,12 @@ impl MassSpring {
             self.next[pin.node as usize] = pin.position(time + dt);
         }
         extras.correct(cloth, state, dt, &mut self.next);
+        if self.hook.active() {
+            let tc = Instant::now();
+            self.hook
+                .enforce(&mut self.next, pos, inv, dt, frac, t_left);
+            timings.shape += tc.elapsed();
+        }
         for ((v, x1), x0) in self.velocity.iter_mut().zip(&self.next).zip(pos) {
             *v = (x1 - x0) / dt;
         }
@@ -294,7 +507,7 @@ impl MassSpring {
             time: state.time.to_bits(),
             dt: dt.to_bits(),
         });
-        Ok(report(cloth, state, 1))
+        Ok(())
     }
 
     /// An analytic estimate of the largest stable Δt of this baseline on `cloth`, s: the

@@ -48,6 +48,48 @@
 //! comparison pointless. The hinge rests straight; on curved grid lines (annulus rings) it also
 //! carries an in-plane term of the ring's curvature, which the stretch springs resist anyway.
 
+//! # Collisions and seams (the garment pipeline)
+//!
+//! Both baselines take the same [`CollisionHook`] as the PARTY step ([`Xpbd::step_with`],
+//! [`MassSpring::step_with`]), with the same meaning, so that the garment simulation can run any
+//! of the three solvers on the same scene:
+//!
+//! - `transfer` is called once per step, before the constraint solve, with the positions at the
+//!   start of the step and the velocities the step starts from (XPBD: the state's velocity;
+//!   mass-spring: the same, and a change it makes to a node's velocity enters the Verlet
+//!   recursion as that change of the node's previous position). It moves cloth with a moving
+//!   body and hands out the step's [`Tie`]s and [`ContactPlane`]s, for the whole step of length
+//!   Δt (the hook's `dt` is the outer Δt, not the substep).
+//! - The ties and planes are enforced in **every substep** as position constraints (both
+//!   baselines' substeps are position updates): XPBD after its prediction and after each
+//!   Gauss–Seidel sweep (the distance constraints, the hinges, then the ties, then the planes);
+//!   the mass-spring model, being explicit, once after the Verlet update of each substep, as a
+//!   position correction (which the recursion then sees as a velocity change) — documented
+//!   choice: the springs are forces, the seams and the body are hard constraints. A tie whose
+//!   pair starts the step farther apart than its `length` is closed gradually: at the end of
+//!   substep k of n the pair may be at most `gap₀ + (length − gap₀)·k/n` apart (`gap₀` its
+//!   distance at the start of the step), so a seam is drawn together over the step as in PARTY,
+//!   whose constraint is on the end of the step, instead of being yanked in the first substep.
+//!   A contact plane (its point at the end of the step) is carried back along its body velocity
+//!   to the end of each substep (`point − velocity·(t_end − t_k)`), and the node is put in front
+//!   of it with the plane's Coulomb friction on its displacement relative to the body over the
+//!   substep — PARTY's rule ([`crate::step`]) applied to the substep's velocity `(x − x_k)/h`.
+//!   A node that starts the step behind its plane (within the skin, or inside) is brought out
+//!   gradually, like a tie: at the end of substep k it may still be `d₀·(1 − k/n)` behind
+//!   (`d₀ < 0` its distance at the start), in front by the end of the step as in PARTY.
+//!   (Measured: pushed out within one substep, a node of the explicit model leaves with the
+//!   push over the substep, `d₀/h`, up to 75 m/s at h = 40 µs, and the mass-spring skirt of
+//!   `crates/atelier/tests/baselines.rs` rang up to 100 m/s within 0.05 s; with the gradual
+//!   push its fastest node stays at the 5–10 m/s its placement's strains release.)
+//!   Pinned nodes are left alone.
+//! - `resolve` is called once, after the last substep (pass 0): it sees the whole step as
+//!   PARTY's does — positions at the start, velocities `(x_end − x_start)/Δt` — and a change it
+//!   makes to a node's velocity moves the node's end position by that change times Δt and is
+//!   added to the node's velocity, as is its `exit` velocity (thesis (72)).
+//!
+//! `step` is `step_with(NoCollision)` and gives bit-identical numbers to the baselines without
+//! a hook (tested).
+
 pub mod mass_spring;
 pub mod xpbd;
 
@@ -58,9 +100,11 @@ use atelier_fabric::{Branch, TensileLoop};
 use atelier_grid::NO_NODE;
 use nalgebra::Vector3;
 
+use atelier_collide::ContactPlane;
+
 use crate::cloth::Cloth;
 use crate::state::ClothState;
-use crate::step::{Stage, StepError};
+use crate::step::{CollisionHook, HookContext, Stage, StageTimings, StepError, Tie, plane_push};
 
 type V3 = Vector3<f64>;
 
@@ -76,6 +120,10 @@ pub struct BaselineReport {
     pub kinetic_energy: f64,
     /// Fastest node after the step, m/s.
     pub max_speed: f64,
+    /// Wall time of the step: `velocity` the predictions (XPBD) or forces and integration
+    /// (mass-spring), `shape` the constraint sweeps (XPBD, with the ties and planes) or the
+    /// ties and planes (mass-spring), `transfer` and `collision` the hook, `update` the commit.
+    pub timings: StageTimings,
 }
 
 /// The secant stiffness `E = f_ref / (φ⁺(f_ref) − φ⁺(0))` (force per width over strain, N/m) of
@@ -253,5 +301,169 @@ pub(crate) fn report(cloth: &Cloth, state: &ClothState, iterations: usize) -> Ba
             .iter()
             .map(|v| v.norm())
             .fold(0.0, f64::max),
+        timings: StageTimings::default(),
+    }
+}
+
+/// The hook's state over one baseline step (module docs, "Collisions and seams"): its ties with
+/// their gaps at the start of the step, its contact planes, its exit velocities.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct HookState {
+    ties: Vec<Tie>,
+    /// Each tie's distance at the start of the step, m.
+    gap0: Vec<f64>,
+    planes: Vec<ContactPlane>,
+    /// Nodes with a plane this step.
+    plane_nodes: Vec<u32>,
+    /// Each plane node's distance in front of its plane at the start of the step (negative:
+    /// behind it), m.
+    plane_d0: Vec<f64>,
+    exit: Vec<V3>,
+    /// Whole-step velocities handed to `resolve`, and a copy to see what it changed.
+    vel: Vec<V3>,
+    vel_before: Vec<V3>,
+}
+
+impl HookState {
+    /// Call the hook's `transfer` at the start of a step of length `dt`: `velocities` (the
+    /// velocities the step starts from) may be changed; the ties and planes are kept for
+    /// [`HookState::enforce`].
+    pub fn transfer(
+        &mut self,
+        hook: &mut dyn CollisionHook,
+        cloth: &Cloth,
+        positions: &[V3],
+        velocities: &mut [V3],
+        dt: f64,
+        time: f64,
+    ) {
+        let n = positions.len();
+        resize(&mut self.planes, n, ContactPlane::default());
+        resize(&mut self.exit, n, V3::zeros());
+        self.planes.fill(ContactPlane::default());
+        self.exit.fill(V3::zeros());
+        self.ties.clear();
+        hook.transfer(HookContext {
+            positions,
+            velocities,
+            exit: &mut self.exit,
+            inverse_masses: cloth.inverse_masses(),
+            dt,
+            time,
+            pass: 0,
+            planes: &mut self.planes,
+            ties: &mut self.ties,
+        });
+        let inv = cloth.inverse_masses();
+        // Ties naming nodes outside the cloth are the hook's bug; they are ignored rather
+        // than allowed to panic.
+        self.ties
+            .retain(|t| (t.a as usize) < n && (t.b as usize) < n && t.length.is_finite());
+        self.gap0.clear();
+        self.gap0.extend(
+            self.ties
+                .iter()
+                .map(|t| (positions[t.b as usize] - positions[t.a as usize]).norm()),
+        );
+        self.plane_nodes.clear();
+        self.plane_nodes.extend(
+            (0..n as u32).filter(|&i| {
+                self.planes[i as usize].normal != V3::zeros() && inv[i as usize] > 0.0
+            }),
+        );
+        self.plane_d0.clear();
+        self.plane_d0.extend(self.plane_nodes.iter().map(|&i| {
+            let p = &self.planes[i as usize];
+            (positions[i as usize] - (p.point - p.velocity * dt)).dot(&p.normal)
+        }));
+    }
+
+    /// Whether the step has ties or planes to enforce.
+    pub fn active(&self) -> bool {
+        !self.ties.is_empty() || !self.plane_nodes.is_empty()
+    }
+
+    /// Enforce the ties, then the planes, on the positions `x` at the end of a substep that
+    /// started at `x_old`, lasted `h`, ends a fraction `frac` into the step and `t_left` before
+    /// its end (module docs).
+    pub fn enforce(&self, x: &mut [V3], x_old: &[V3], inv: &[f64], h: f64, frac: f64, t_left: f64) {
+        for (tie, &g0) in self.ties.iter().zip(&self.gap0) {
+            let (a, b) = (tie.a as usize, tie.b as usize);
+            let ws = inv[a] + inv[b];
+            if ws <= 0.0 {
+                continue;
+            }
+            let length = if g0 > tie.length {
+                g0 + (tie.length - g0) * frac
+            } else {
+                tie.length
+            };
+            let gap = x[b] - x[a];
+            let l = gap.norm();
+            if l <= length || l == 0.0 {
+                continue;
+            }
+            let shift = gap * ((l - length) / (l * ws));
+            x[a] += shift * inv[a];
+            x[b] -= shift * inv[b];
+        }
+        for (&i, &d0) in self.plane_nodes.iter().zip(&self.plane_d0) {
+            let i = i as usize;
+            let mut plane = self.planes[i];
+            plane.point -= plane.velocity * t_left;
+            if d0 < 0.0 {
+                // Behind its plane at the start: brought out gradually, in front by the end.
+                plane.point += plane.normal * (d0 * (1.0 - frac));
+            }
+            let v = (x[i] - x_old[i]) / h;
+            x[i] = x_old[i] + plane_push(v, &x_old[i], &plane, h) * h;
+        }
+    }
+
+    /// Call the hook's `resolve` once after the last substep: `start` the positions at the
+    /// start of the step, `end` at its end (changed where the hook changed a node's
+    /// velocity). Returns, per node, the change of velocity to add to the node's velocity
+    /// (the hook's change plus its exit velocity), or `None` when nothing changed.
+    pub fn resolve(
+        &mut self,
+        hook: &mut dyn CollisionHook,
+        cloth: &Cloth,
+        start: &[V3],
+        end: &mut [V3],
+        dt: f64,
+        time: f64,
+    ) -> Option<&[V3]> {
+        let n = start.len();
+        resize(&mut self.vel, n, V3::zeros());
+        resize(&mut self.vel_before, n, V3::zeros());
+        for ((v, x1), x0) in self.vel.iter_mut().zip(end.iter()).zip(start) {
+            *v = (x1 - x0) / dt;
+        }
+        self.vel_before.copy_from_slice(&self.vel);
+        hook.resolve(HookContext {
+            positions: start,
+            velocities: &mut self.vel,
+            exit: &mut self.exit,
+            inverse_masses: cloth.inverse_masses(),
+            dt,
+            time,
+            pass: 0,
+            planes: &mut self.planes,
+            ties: &mut self.ties,
+        });
+        let mut changed = false;
+        for i in 0..n {
+            let (after, before) = (self.vel[i], self.vel_before[i]);
+            let dv = if after == before {
+                V3::zeros()
+            } else {
+                end[i] = start[i] + after * dt;
+                after - before
+            };
+            // vel now holds the change to add to the node's velocity.
+            self.vel[i] = dv + self.exit[i];
+            changed |= self.vel[i] != V3::zeros();
+        }
+        changed.then_some(self.vel.as_slice())
     }
 }

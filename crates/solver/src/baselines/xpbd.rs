@@ -34,14 +34,16 @@
 use atelier_grid::NO_NODE;
 use serde::{Deserialize, Serialize};
 
+use std::time::Instant;
+
 use super::{
-    BaselineReport, Hinge, V3, check_input, fill_hinges, fill_stiffness, first_non_finite,
-    non_finite, report, resize,
+    BaselineReport, Hinge, HookState, V3, check_input, fill_hinges, fill_stiffness,
+    first_non_finite, non_finite, report, resize,
 };
 use crate::cloth::Cloth;
 use crate::params::{ParamError, check, check_motion};
 use crate::state::ClothState;
-use crate::step::{Stage, StepError};
+use crate::step::{CollisionHook, NoCollision, Stage, StepError};
 
 /// Parameters of the XPBD baseline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -130,6 +132,8 @@ pub struct Xpbd {
     v: Vec<V3>,
     lambda: Vec<f64>,
     lambda_bend: Vec<V3>,
+    /// The collision hook's ties, planes and exit velocities over a step.
+    hook: HookState,
     /// Time and Δt (bit patterns) after the last committed step.
     history: Option<(u64, u64)>,
 }
@@ -153,6 +157,23 @@ impl Xpbd {
         state: &mut ClothState,
         params: &XpbdParams,
     ) -> Result<BaselineReport, StepError> {
+        self.step_with(cloth, state, params, &mut NoCollision)
+    }
+
+    /// One step with a collision hook, as the PARTY step drives it ([`crate::baselines`],
+    /// "Collisions and seams"): `transfer` once before the substeps (the hook's Δt is the
+    /// step's, not the substep's), its ties and contact planes enforced as position constraints
+    /// after the prediction and after every sweep of every substep, `resolve` once after the
+    /// last substep. On error the state is unchanged.
+    pub fn step_with(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &XpbdParams,
+        hook: &mut dyn CollisionHook,
+    ) -> Result<BaselineReport, StepError> {
+        let t_start = Instant::now();
+        let mut timings = crate::step::StageTimings::default();
         params.validate()?;
         check_input(cloth, state)?;
         let topo = cloth.topology();
@@ -178,7 +199,18 @@ impl Xpbd {
         let inv_h2 = 1.0 / (h * h);
         let colours = cloth.colour_count();
 
+        let tc = Instant::now();
+        self.hook
+            .transfer(hook, cloth, &state.positions, &mut self.v, dt, time);
+        if let Some(i) = first_non_finite(&self.v) {
+            return Err(non_finite(Stage::Collision, "velocity", "node", i, time));
+        }
+        timings.transfer = tc.elapsed();
+        let hooked = self.hook.active();
+
         for sub in 0..params.substeps {
+            let frac = (sub + 1) as f64 / params.substeps as f64;
+            let t_left = dt * (1.0 - frac);
             let t1 = if sub + 1 == params.substeps {
                 time + dt
             } else {
@@ -197,6 +229,10 @@ impl Xpbd {
             }
             for pin in cloth.pins() {
                 self.x[pin.node as usize] = pin.position(t1);
+            }
+            if hooked {
+                self.hook
+                    .enforce(&mut self.x, &self.x_old, inv, h, frac, t_left);
             }
             if let Some(i) = first_non_finite(&self.x) {
                 return Err(non_finite(
@@ -241,6 +277,10 @@ impl Xpbd {
                 for (hinge, lambda) in self.hinges.iter().zip(self.lambda_bend.iter_mut()) {
                     solve_hinge(&mut self.x, inv, hinge, inv_h2 / hinge.stiffness, lambda);
                 }
+                if hooked {
+                    self.hook
+                        .enforce(&mut self.x, &self.x_old, inv, h, frac, t_left);
+                }
             }
             if let Some(e) = self.lambda.iter().position(|l| !l.is_finite()) {
                 return Err(non_finite(
@@ -280,11 +320,33 @@ impl Xpbd {
             }
         }
 
+        // The hook's collision pass over the whole step.
+        let tc = Instant::now();
+        if let Some(dv) = self
+            .hook
+            .resolve(hook, cloth, &state.positions, &mut self.x, dt, time)
+        {
+            for (v, d) in self.v.iter_mut().zip(dv) {
+                *v += d;
+            }
+        }
+        if let Some(i) = first_non_finite(&self.x).or_else(|| first_non_finite(&self.v)) {
+            return Err(non_finite(Stage::Collision, "velocity", "node", i, time));
+        }
+        timings.collision = tc.elapsed();
+
+        let tu = Instant::now();
         state.positions.copy_from_slice(&self.x);
         state.velocities.copy_from_slice(&self.v);
         state.time += dt;
         self.history = Some((state.time.to_bits(), dt.to_bits()));
-        Ok(report(cloth, state, params.substeps * params.iterations))
+        let mut r = report(cloth, state, params.substeps * params.iterations);
+        timings.update = tu.elapsed();
+        timings.shape = t_start
+            .elapsed()
+            .saturating_sub(timings.transfer + timings.collision + timings.update);
+        r.timings = timings;
+        Ok(r)
     }
 }
 

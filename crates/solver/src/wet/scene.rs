@@ -752,7 +752,7 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
                 params,
                 extras,
             } => solver
-                .step_with(&cloth, &mut state, params, extras.as_mut())
+                .step_with_extras(&cloth, &mut state, params, extras.as_mut())
                 .map(|_| ()),
             Engine::Party {
                 solver,
