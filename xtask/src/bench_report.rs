@@ -58,7 +58,7 @@ const SCENARIOS: [&str; 6] = [
 ];
 
 /// The figure sets the report shows.
-const FIGURE_SETS: [&str; 2] = ["solver", "stability"];
+const FIGURE_SETS: [&str; 3] = ["solver", "stability", "tradeoff"];
 
 /// Run the steps not skipped and render the report.
 pub fn run(root: &Path, out: &Path, skip: &[Step]) -> Result<()> {
@@ -90,7 +90,8 @@ pub fn run(root: &Path, out: &Path, skip: &[Step]) -> Result<()> {
             eprintln!("bench-report: figures {set}");
             let draw: crate::DrawAll = match set {
                 "solver" => crate::figures_solver::draw_all,
-                _ => crate::figures_stability::draw_all,
+                "stability" => crate::figures_stability::draw_all,
+                _ => crate::figures_tradeoff::draw_all,
             };
             draw(root, &dir)?;
         }

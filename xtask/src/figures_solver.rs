@@ -41,11 +41,11 @@ use anyhow::{Context, Result, bail};
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
+use atelier_solver::metrics::{DEFAULT_SHADOW_ROWS, Shadow, drape_coefficient};
 use atelier_solver::{
     Cloth, ClothOptions, ClothState, PinMotion, ShapeMethod, Solver, StepError, StepParams,
     TolerancePolicy,
 };
-use atelier_solver::metrics::{DEFAULT_SHADOW_ROWS, Shadow, drape_coefficient};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -140,8 +140,10 @@ impl Run {
     /// of the cloth's projected triangles and the support disk (NaN when the run failed).
     fn drape_coefficient(&self, cloth: &Cloth) -> f64 {
         self.outcome.as_ref().map_or(f64::NAN, |p| {
-            let positions: Vec<nalgebra::Vector3<f64>> =
-                p.iter().map(|x| nalgebra::Vector3::new(x[0], x[1], x[2])).collect();
+            let positions: Vec<nalgebra::Vector3<f64>> = p
+                .iter()
+                .map(|x| nalgebra::Vector3::new(x[0], x[1], x[2]))
+                .collect();
             let mut shadow = Shadow::new(DEFAULT_SHADOW_ROWS);
             shadow.add_triangles(&positions, cloth.topology().triangles());
             shadow.add_disk([0.0, 0.0], R_INNER);

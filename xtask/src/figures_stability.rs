@@ -228,10 +228,10 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
             let limits: Vec<Option<f64>> = (0..FABRICS.len())
                 .map(|f| {
                     let mut last = None;
-                    for d in 0..STEPS_MS.len() {
+                    for (d, &ms) in STEPS_MS.iter().enumerate() {
                         match at(s, f, v, d).0 {
                             Outcome::NotRun => continue,
-                            Outcome::Stable => last = Some(STEPS_MS[d]),
+                            Outcome::Stable => last = Some(ms),
                             o => {
                                 beyond.insert(o.word());
                                 break;
@@ -242,13 +242,12 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
                 })
                 .collect();
             let text = |x: Option<f64>| x.map_or("none".to_string(), |ms| format!("{ms} ms"));
-            let lo = limits
+            // The smallest limit over the fabrics ("none" if some fabric was never stable).
+            let lo: Option<f64> = limits
                 .iter()
                 .copied()
-                .fold(Some(f64::MAX), |a, b| match (a, b) {
-                    (Some(a), Some(b)) => Some(a.min(b)),
-                    _ => None,
-                });
+                .collect::<Option<Vec<f64>>>()
+                .map(|l| l.into_iter().fold(f64::MAX, f64::min));
             let hi = limits
                 .iter()
                 .copied()
