@@ -73,7 +73,9 @@ pub fn run(root: &Path, out: &Path, skip: &[Step]) -> Result<()> {
         }
         eprintln!("bench-report: cargo bench --workspace (criterion, about 25 minutes)");
         let status = Command::new(env_or("CARGO", "cargo"))
-            .args(["bench", "--workspace", "--benches"])
+            // No criterion plots: its plotting backend needs a system font this machine may
+            // lack (it panics without one), and the report reads the numbers, not the plots.
+            .args(["bench", "--workspace", "--benches", "--", "--noplot"])
             .current_dir(root)
             .status()
             .context("starting cargo bench")?;
