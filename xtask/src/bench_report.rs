@@ -75,7 +75,7 @@ pub fn run(root: &Path, out: &Path, skip: &[Step]) -> Result<()> {
         let status = Command::new(env_or("CARGO", "cargo"))
             // No criterion plots: its plotting backend needs a system font this machine may
             // lack (it panics without one), and the report reads the numbers, not the plots.
-            .args(["bench", "--workspace", "--benches", "--", "--noplot"])
+            .args(["bench", "--workspace", "--bench", "*", "--", "--noplot"])
             .current_dir(root)
             .status()
             .context("starting cargo bench")?;
