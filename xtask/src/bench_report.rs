@@ -507,7 +507,8 @@ struct PeerFile {
 #[derive(Deserialize, Clone)]
 struct PeerRow {
     scene: String,
-    side: usize,
+    /// Nodes per side of the sheet (none for the drape).
+    side: Option<usize>,
     setting: String,
     ms_per_step: Option<f64>,
     stretch_end: Option<f64>,
@@ -595,7 +596,7 @@ fn peers_table(arg: &str, src: &Sources) -> Result<String> {
         for r in f
             .rows
             .iter()
-            .filter(|r| r.scene == "sheet" && r.side == side)
+            .filter(|r| r.scene == "sheet" && r.side == Some(side))
         {
             let _ = writeln!(
                 t,
@@ -687,7 +688,7 @@ fn peers_goal(src: &Sources) -> Result<String> {
         party
             .rows
             .iter()
-            .filter(|r| r.scene == "sheet" && r.side == side && r.diverged_at_s.is_none())
+            .filter(|r| r.scene == "sheet" && r.side == Some(side) && r.diverged_at_s.is_none())
             .filter(|r| pred(r))
             .filter_map(|r| Some((r.ms_per_step?, r.setting.clone(), r.stretch_end?)))
             .min_by(|a, b| a.0.total_cmp(&b.0))

@@ -363,6 +363,9 @@ fn write_report(name: &str, text: &str) {
 }
 
 fn party(c: &mut Criterion) {
+    if scaling_child().is_some() {
+        return;
+    }
     let fabric = cotton();
     let measuring = measuring();
     let mut rows = Vec::new();
@@ -417,6 +420,9 @@ fn party(c: &mut Criterion) {
 
 /// The baselines on the 2 704-node scene, warmed up for the same simulated time as PARTY.
 fn baselines(c: &mut Criterion) {
+    if scaling_child().is_some() {
+        return;
+    }
     const SIDE: usize = 52;
     let fabric = cotton();
     let measuring = measuring();
@@ -578,86 +584,101 @@ fn selected(name: &str) -> bool {
     filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()))
 }
 
-/// Resident memory of this process, bytes (`/proc/self/statm`; 0 where there is none).
-fn resident_bytes() -> usize {
-    std::fs::read_to_string("/proc/self/statm")
+/// A field of `/proc/self/status` in bytes (`VmRSS`, `VmHWM`; 0 where there is none).
+fn status_bytes(field: &str) -> usize {
+    std::fs::read_to_string("/proc/self/status")
         .ok()
-        .and_then(|s| s.split_whitespace().nth(1)?.parse::<usize>().ok())
-        .map_or(0, |pages| pages * 4096)
+        .and_then(|s| {
+            let line = s.lines().find(|l| l.starts_with(field))?;
+            line.split_whitespace().nth(1)?.parse::<usize>().ok()
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
+/// Environment variables of a scaling child process: the sheet's side, and the file its table
+/// row goes to.
+const SCALING_SIDE_VAR: &str = "ATELIER_SCALING_SIDE";
+const SCALING_ROW_VAR: &str = "ATELIER_SCALING_ROW";
+
+/// The side this process measures when it is a scaling child.
+fn scaling_child() -> Option<usize> {
+    std::env::var(SCALING_SIDE_VAR).ok()?.parse().ok()
 }
 
 /// Sides of the scaling sheets: 289 to 100 489 nodes.
 const SCALING_SIDES: [usize; 7] = [17, 32, 71, 100, 158, 224, 317];
 
-/// Scaling (issue 10): wall time per step with 1 and 2 rayon threads and resident memory per
-/// node, from 289 to 100 489 nodes (the sheet of [`Fixture`]). Per size: the resident memory
-/// added by building the scene, warming it up and stepping once (cloth, state, solver and its
-/// scratch; measured as the growth of the process's resident set, so at 4 kB resolution), then
-/// per thread count the median of at least three steps (until 2 s) from clones of the same
-/// warmed-up state. Table: stderr and `$CARGO_TARGET_DIR/atelier-bench/scaling.md`, with the
-/// slope of log time against log nodes from 10 000 nodes up. `cargo test --benches` runs the
-/// smallest size only.
+/// Scaling (issue 10): wall time per step with 1 and 2 rayon threads and memory per node, from
+/// 289 to 100 489 nodes (the sheet of [`Fixture`]). Each size runs in a child process of this
+/// bench (`ATELIER_SCALING_SIDE`), so that sizes share no allocator state: it builds the scene,
+/// warms it up, takes per thread count the median of at least three steps (until 2 s) from
+/// clones of the same warmed-up state, and reports its peak resident memory (`VmHWM`) less its
+/// resident memory before the scene was built — the cloth, state, solver, scratch and the
+/// gridding's temporaries, at 4 kB resolution. Table: stderr and
+/// `$CARGO_TARGET_DIR/atelier-bench/scaling.md`, with the slope of log time against log nodes
+/// from 10 000 nodes up. `cargo test --benches` runs the smallest size only, in process.
 fn scaling(_c: &mut Criterion) {
+    if let Some(side) = scaling_child() {
+        let row = scaling_row(side);
+        let path = std::env::var(SCALING_ROW_VAR).expect("the row's file");
+        std::fs::write(
+            &path,
+            format!("{} {} {} {} {}", row.0, row.1, row.2, row.3, row.4),
+        )
+        .expect("writing the row");
+        return;
+    }
     if !selected("scaling") {
         return;
     }
-    let fabric = cotton();
     let sides: &[usize] = if measuring() {
         &SCALING_SIDES
     } else {
         &SCALING_SIDES[..1]
     };
-    let pools: Vec<(usize, rayon::ThreadPool)> = [1, 2]
-        .into_iter()
-        .map(|t| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .expect("thread pool");
-            (t, pool)
-        })
-        .collect();
     let mut table = String::from(
-        "| nodes | edges | 1 thread, ms/step | 2 threads, ms/step | speed-up | µs per node (2 threads) | resident bytes per node |\n|---|---|---|---|---|---|---|\n",
+        "| nodes | edges | 1 thread, ms/step | 2 threads, ms/step | speed-up | µs per node (2 threads) | peak resident bytes per node |\n|---|---|---|---|---|---|---|\n",
     );
     let mut points = Vec::new();
     for &side in sides {
-        let before = resident_bytes();
-        let mut fx = Fixture::new(&fabric, side);
-        let (nodes, edges) = (fx.nodes(), fx.edges());
-        let per_thread: Vec<f64> = pools
-            .iter()
-            .map(|(_, pool)| {
-                pool.install(|| {
-                    let mut times = Vec::new();
-                    let budget = Instant::now();
-                    while times.len() < 3
-                        || (measuring() && budget.elapsed().as_secs_f64() < 2.0 && times.len() < 50)
-                    {
-                        let mut state = fx.state.clone();
-                        let t0 = Instant::now();
-                        fx.solver
-                            .step(&fx.cloth, &mut state, &fx.params)
-                            .expect("step");
-                        times.push(t0.elapsed().as_secs_f64());
-                        black_box(&state);
-                    }
-                    median_f64(times)
-                })
-            })
-            .collect();
-        let memory = resident_bytes().saturating_sub(before) as f64 / nodes as f64;
-        points.push((nodes as f64, per_thread[1]));
+        let (nodes, edges, one, two, memory) = if measuring() {
+            let path = report_path(&format!("scaling_row_{side}.txt"));
+            if let Some(dir) = path.parent() {
+                std::fs::create_dir_all(dir).expect("report folder");
+            }
+            let status = std::process::Command::new(std::env::current_exe().expect("this bench"))
+                .args(["--bench", "scaling"])
+                .env(SCALING_SIDE_VAR, side.to_string())
+                .env(SCALING_ROW_VAR, &path)
+                .status()
+                .expect("starting the scaling child");
+            assert!(status.success(), "the scaling child for side {side} failed");
+            let text = std::fs::read_to_string(&path).expect("the child's row");
+            let _ = std::fs::remove_file(&path);
+            let v: Vec<f64> = text
+                .split_whitespace()
+                .map(|x| x.parse().expect("a number"))
+                .collect();
+            (v[0] as usize, v[1] as usize, v[2], v[3], v[4])
+        } else {
+            // In process (criterion's test mode): the peak includes everything run before.
+            let r = scaling_row(side);
+            (r.0, r.1, r.2, r.3, f64::NAN)
+        };
+        points.push((nodes as f64, two));
         let _ = writeln!(
             table,
-            "| {nodes} | {edges} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} |",
-            per_thread[0] * 1e3,
-            per_thread[1] * 1e3,
-            per_thread[0] / per_thread[1],
-            per_thread[1] * 1e6 / nodes as f64,
-            memory
+            "| {nodes} | {edges} | {:.2} | {:.2} | {:.2} | {:.2} | {} |",
+            one * 1e3,
+            two * 1e3,
+            one / two,
+            two * 1e6 / nodes as f64,
+            if memory.is_finite() {
+                format!("{memory:.0}")
+            } else {
+                "— (in process)".to_string()
+            }
         );
-        drop(fx);
     }
     let large: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.0 >= 10_000.0).collect();
     if large.len() >= 2 {
@@ -679,6 +700,42 @@ fn scaling(_c: &mut Criterion) {
     }
     eprintln!("{table}");
     write_report("scaling.md", &table);
+}
+
+/// One size of [`scaling`]: nodes, edges, the median step with 1 and with 2 threads (s), and
+/// the peak resident bytes per node added by the scene.
+fn scaling_row(side: usize) -> (usize, usize, f64, f64, f64) {
+    let fabric = cotton();
+    let before = status_bytes("VmRSS:");
+    let mut fx = Fixture::new(&fabric, side);
+    let (nodes, edges) = (fx.nodes(), fx.edges());
+    let per_thread: Vec<f64> = [1, 2]
+        .into_iter()
+        .map(|threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("thread pool");
+            pool.install(|| {
+                let mut times = Vec::new();
+                let budget = Instant::now();
+                while times.len() < 3
+                    || (measuring() && budget.elapsed().as_secs_f64() < 2.0 && times.len() < 50)
+                {
+                    let mut state = fx.state.clone();
+                    let t0 = Instant::now();
+                    fx.solver
+                        .step(&fx.cloth, &mut state, &fx.params)
+                        .expect("step");
+                    times.push(t0.elapsed().as_secs_f64());
+                    black_box(&state);
+                }
+                median_f64(times)
+            })
+        })
+        .collect();
+    let memory = status_bytes("VmHWM:").saturating_sub(before) as f64 / nodes as f64;
+    (nodes, edges, per_thread[0], per_thread[1], memory)
 }
 
 /// The peers' scene (issue 10): a 1 m square sheet of `side × side` nodes pinned at its two
@@ -733,7 +790,7 @@ fn peer_scene(
 /// failed run is a row saying so. `cargo test --benches` runs the 50 × 50 sheet with the
 /// attachments only.
 fn peers(_c: &mut Criterion) {
-    if !selected("peers") {
+    if !selected("peers") || scaling_child().is_some() {
         return;
     }
     let fabric = cotton();
