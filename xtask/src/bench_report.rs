@@ -131,7 +131,8 @@ pub fn run(root: &Path, out: &Path, skip: &[Step]) -> Result<()> {
     let template = root.join("xtask/performance.md.in");
     let text = std::fs::read_to_string(&template)
         .with_context(|| format!("reading {}", template.display()))?;
-    let rendered = render(&text, &sources)?;
+    let (rendered, figures) = render(&text, &sources)?;
+    publish(&figures)?;
     atelier_fabric::files::write_atomic(&root.join("docs/performance.md"), rendered.as_bytes())?;
     eprintln!(
         "bench-report: wrote docs/performance.md ({:.0} s)",
@@ -203,8 +204,9 @@ impl Sources {
 }
 
 /// Render the template; every missing input is collected and reported together.
-fn render(template: &str, src: &Sources) -> Result<String> {
+fn render(template: &str, src: &Sources) -> Result<(String, Vec<(PathBuf, PathBuf)>)> {
     let mut out = String::new();
+    let mut figures = Vec::new();
     let mut missing = Vec::new();
     let mut lines = template.lines().enumerate();
     while let Some((n, line)) = lines.next() {
@@ -238,8 +240,8 @@ fn render(template: &str, src: &Sources) -> Result<String> {
             "include" => std::fs::read_to_string(src.path(arg))
                 .map(|t| t.trim_end().to_string())
                 .map_err(|e| anyhow::anyhow!("{arg}: {e}")),
-            "figure" => figure(arg, src),
-            "peers" => peers_table(arg, src),
+            "figure" => figure(arg, src, &mut figures),
+            "peers" => peers_table(arg, src, &mut figures),
             "peers-goal" => peers_goal(src),
             "scenarios" => scenarios_table(arg, src),
             other => Err(anyhow::anyhow!("unknown directive @@{other}")),
@@ -258,7 +260,7 @@ fn render(template: &str, src: &Sources) -> Result<String> {
             missing.join("\n  ")
         );
     }
-    Ok(out)
+    Ok((out, figures))
 }
 
 /// Replace `{{…}}` placeholders in a line.
@@ -452,18 +454,29 @@ fn bench_table(rows: &[String], criterion: &BTreeMap<String, PathBuf>) -> Result
     Ok(t.trim_end().to_string())
 }
 
-/// Copy a figure of the run into `docs/img/SET/` and return its markdown.
-fn figure(arg: &str, src: &Sources) -> Result<String> {
+/// A figure of the run to show: checked now, copied into `docs/img/SET/` by [`publish`] once
+/// the whole report rendered; returns its markdown.
+fn figure(arg: &str, src: &Sources, figures: &mut Vec<(PathBuf, PathBuf)>) -> Result<String> {
     let (rel, caption) = arg.split_once('|').unwrap_or((arg, ""));
     let rel = rel.trim();
     let from = src.out.join("figures").join(rel);
-    let to = src.root.join("docs/img").join(rel);
-    let bytes = std::fs::read(&from).with_context(|| format!("figure {}", from.display()))?;
-    if let Some(dir) = to.parent() {
-        std::fs::create_dir_all(dir)?;
+    if !from.is_file() {
+        bail!("figure {} missing", from.display());
     }
-    atelier_fabric::files::write_atomic(&to, &bytes)?;
+    figures.push((from, src.root.join("docs/img").join(rel)));
     Ok(format!("![{}](img/{rel})", caption.trim()))
+}
+
+/// Copy the report's figures into `docs/img/` (each atomically).
+fn publish(figures: &[(PathBuf, PathBuf)]) -> Result<()> {
+    for (from, to) in figures {
+        let bytes = std::fs::read(from).with_context(|| format!("figure {}", from.display()))?;
+        if let Some(dir) = to.parent() {
+            std::fs::create_dir_all(dir)?;
+        }
+        atelier_fabric::files::write_atomic(to, &bytes)?;
+    }
+    Ok(())
 }
 
 /// The log–log slope of the 2-thread time per step against nodes, from 10 000 nodes, read
@@ -539,7 +552,7 @@ fn percent(x: Option<f64>) -> String {
 
 /// The peers' table for one sheet size (and the drape rows with `drape`), with the figure of
 /// time per step against stretch drawn beside it.
-fn peers_table(arg: &str, src: &Sources) -> Result<String> {
+fn peers_table(arg: &str, src: &Sources, figures: &mut Vec<(PathBuf, PathBuf)>) -> Result<String> {
     let files = peer_files(src)?;
     if arg == "drape" {
         let mut t = String::from(
@@ -618,8 +631,9 @@ fn peers_table(arg: &str, src: &Sources) -> Result<String> {
         series.push((f.peer.clone(), points));
     }
     let name = format!("peers_{side}.png");
-    let dir = src.root.join("docs/img/peers");
+    let dir = src.out.join("figures/peers");
     std::fs::create_dir_all(&dir)?;
+    figures.push((dir.join(&name), src.root.join("docs/img/peers").join(&name)));
     plot::register_font()?;
     plot::png(&dir.join(&name), (900, 600), |area| {
         let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.1.clone()).collect();
@@ -828,6 +842,7 @@ mod tests {
             out: PathBuf::from("/nonexistent/out"),
         };
         let err = render("# title\n@@include bench/x.md\nok {{bench:a/b}}\n", &src)
+            .map(|_| ())
             .unwrap_err()
             .to_string();
         assert!(err.contains("performance.md.in:2"), "{err}");
