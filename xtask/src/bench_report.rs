@@ -591,7 +591,13 @@ fn peers_table(arg: &str, src: &Sources, figures: &mut Vec<(PathBuf, PathBuf)>) 
     if arg == "differences" {
         let mut t = String::new();
         for f in files.iter().filter(|f| !f.differences.is_empty()) {
-            let _ = writeln!(t, "{} ({} threads):\n", f.peer, f.threads);
+            let _ = writeln!(
+                t,
+                "{} ({} thread{}):\n",
+                f.peer,
+                f.threads,
+                if f.threads == 1 { "" } else { "s" }
+            );
             for d in &f.differences {
                 let _ = writeln!(t, "- {d}");
             }
@@ -655,11 +661,14 @@ fn peers_table(arg: &str, src: &Sources, figures: &mut Vec<(PathBuf, PathBuf)>) 
             .x_label_area_size(45)
             .y_label_area_size(70)
             .build_cartesian_2d(
-                (x0 * 0.7..x1 * 1.4).log_scale(),
+                ((x0 * 0.7).min(1.5)..x1 * 1.4).log_scale(),
                 (y0.min(0.01) * 0.7..y1 * 1.4).log_scale(),
             )?;
         chart
             .configure_mesh()
+            .x_labels(8)
+            .y_labels(8)
+            .x_label_formatter(&|v| format!("{v:.0}"))
             .x_desc("wall time per step, ms")
             .y_desc("largest edge stretch at 2 s")
             .y_label_formatter(&|v| format!("{:.2} %", 100.0 * v))
@@ -667,11 +676,21 @@ fn peers_table(arg: &str, src: &Sources, figures: &mut Vec<(PathBuf, PathBuf)>) 
         // The goal: 1 % stretch (and, at 50 × 50, 2 ms per step).
         chart
             .draw_series(LineSeries::new(
-                [(x0 * 0.7, 0.01), (x1 * 1.4, 0.01)],
+                [((x0 * 0.7).min(1.5), 0.01), (x1 * 1.4, 0.01)],
                 BLACK.mix(0.4).stroke_width(1),
             ))?
             .label("1 % stretch (the issue's goal)")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.mix(0.4)));
+        // The time goal: 2 ms per step at 50 × 50, 10 ms at 100 × 100.
+        let goal_ms = if side <= 50 { 2.0 } else { 10.0 };
+        let (ylo, yhi) = (y0.min(0.01) * 0.7, y1 * 1.4);
+        chart
+            .draw_series(LineSeries::new(
+                [(goal_ms, ylo), (goal_ms, yhi)],
+                RED.mix(0.5).stroke_width(1),
+            ))?
+            .label(format!("{goal_ms} ms per step (the issue's goal)"))
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.mix(0.5)));
         for (k, (peer, points)) in series.iter().enumerate() {
             let colour = plot::PALETTE[k % plot::PALETTE.len()];
             chart
