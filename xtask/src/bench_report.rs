@@ -654,7 +654,9 @@ fn peers_table(arg: &str, src: &Sources, figures: &mut Vec<(PathBuf, PathBuf)>) 
             .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
         let mut chart = ChartBuilder::on(area)
             .caption(
-                format!("{side} × {side} sheet pinned at two corners, 2 s at Δt 10 ms"),
+                format!(
+                    "{side} × {side} sheet pinned at two corners, 2 s at Δt 10 ms (diverged runs not drawn)"
+                ),
                 ("sans-serif", 22),
             )
             .margin(15)
@@ -702,7 +704,7 @@ fn peers_table(arg: &str, src: &Sources, figures: &mut Vec<(PathBuf, PathBuf)>) 
             .configure_series_labels()
             .background_style(WHITE.mix(0.9))
             .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
+            .position(SeriesLabelPosition::LowerLeft)
             .draw()?;
         Ok(())
     })?;
