@@ -373,8 +373,8 @@ struct Benchmark {
     throughput: Option<BTreeMap<String, u64>>,
 }
 
-/// A criterion result: the median and its 95 % interval in seconds, per element when the bench
-/// declares a throughput.
+/// A criterion result: the median of one iteration and its 95 % interval, in seconds, and the
+/// elements an iteration processes where the bench declares a throughput.
 struct Estimate {
     median: f64,
     low: f64,
@@ -393,11 +393,10 @@ fn estimate(criterion: &BTreeMap<String, PathBuf>, id: &str) -> Result<Estimate>
     let e: Estimates = serde_json::from_str(&read("estimates.json")?)?;
     let b: Benchmark = serde_json::from_str(&read("benchmark.json")?)?;
     let per = b.throughput.and_then(|t| t.values().next().copied());
-    let scale = 1e-9 / per.unwrap_or(1) as f64;
     Ok(Estimate {
-        median: e.median.point_estimate * scale,
-        low: e.median.confidence_interval.lower_bound * scale,
-        high: e.median.confidence_interval.upper_bound * scale,
+        median: e.median.point_estimate * 1e-9,
+        low: e.median.confidence_interval.lower_bound * 1e-9,
+        high: e.median.confidence_interval.upper_bound * 1e-9,
         per,
     })
 }
@@ -433,9 +432,12 @@ fn bench_table(rows: &[String], criterion: &BTreeMap<String, PathBuf>) -> Result
         let id = id.trim();
         match estimate(criterion, id) {
             Ok(e) => {
-                let per = e
-                    .per
-                    .map_or(String::new(), |n| format!(" (per element of {n})"));
+                let per = e.per.map_or(String::new(), |n| {
+                    format!(
+                        " — {} per element, {n} per iteration",
+                        duration(e.median / n as f64)
+                    )
+                });
                 let _ = writeln!(
                     t,
                     "| `{id}` | {}{per} | {} | {} – {} |",

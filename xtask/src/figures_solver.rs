@@ -594,7 +594,15 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
             is_default,
         });
     }
-    mark_pareto(&mut rows);
+    let front = crate::plot::pareto_front(
+        &rows
+            .iter()
+            .map(|r| (r.run.wall.as_secs_f64(), r.error))
+            .collect::<Vec<_>>(),
+    );
+    for (r, on) in rows.iter_mut().zip(front) {
+        r.pareto = on;
+    }
 
     let table = table(
         &cloth,
@@ -606,34 +614,12 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     );
     std::io::stdout().write_all(table.as_bytes())?;
     let md = out.join("time_vs_error.md");
-    write_atomically(&md, &table)?;
+    atelier_fabric::files::write_atomic(&md, table.as_bytes())?;
     let png_path = out.join("time_vs_error.png");
     let written = png(&png_path, (1700, 850), |root| {
         draw(root, &rows, uncertainty)
     })?;
     Ok(vec![written, md])
-}
-
-/// Mark the points no other point beats in both wall time and error.
-fn mark_pareto(rows: &mut [Row]) {
-    let mut order: Vec<usize> = (0..rows.len())
-        .filter(|&i| rows[i].error.is_some())
-        .collect();
-    order.sort_by_key(|&i| rows[i].run.wall);
-    let mut best = f64::INFINITY;
-    for i in order {
-        let e = rows[i].error.unwrap_or(f64::INFINITY);
-        if e < best {
-            best = e;
-            rows[i].pareto = true;
-        }
-    }
-}
-
-fn write_atomically(path: &Path, text: &str) -> Result<()> {
-    let tmp = atelier_fabric::files::temporary_sibling(path);
-    std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("renaming {}", tmp.display()))
 }
 
 /// Δt in the table: plain above 1 ms, else in scientific notation.

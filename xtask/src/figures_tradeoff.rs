@@ -300,28 +300,6 @@ fn rms(a: &[V3], b: &[V3]) -> f64 {
     (s / a.len() as f64).sqrt()
 }
 
-/// Mark the points no other point beats in both wall time and error.
-fn mark_pareto(rows: &mut [Row]) {
-    let mut order: Vec<usize> = (0..rows.len())
-        .filter(|&i| rows[i].error.is_some())
-        .collect();
-    order.sort_by_key(|&i| rows[i].outcome.wall);
-    let mut best = f64::INFINITY;
-    for i in order {
-        let e = rows[i].error.unwrap_or(f64::INFINITY);
-        if e < best {
-            best = e;
-            rows[i].pareto = true;
-        }
-    }
-}
-
-fn write_atomically(path: &Path, text: &str) -> Result<()> {
-    let tmp = atelier_fabric::files::temporary_sibling(path);
-    std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("renaming {}", tmp.display()))
-}
-
 /// The figure set's entry point for `cargo xtask figures tradeoff`.
 pub fn draw_all(_root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     run(out, false)?;
@@ -386,20 +364,26 @@ pub fn run(out: &Path, quick: bool) -> Result<()> {
                 pareto: false,
             });
         }
-        mark_pareto(&mut rows);
+        let front = crate::plot::pareto_front(
+            &rows
+                .iter()
+                .map(|r| (r.outcome.wall.as_secs_f64(), r.error))
+                .collect::<Vec<_>>(),
+        );
+        for (r, on) in rows.iter_mut().zip(front) {
+            r.pareto = on;
+        }
         let md = out.join(format!("tradeoff_{}.md", scene.name));
-        write_atomically(
-            &md,
-            &table(
-                &scene,
-                &rows,
-                &r,
-                &reference_cfg,
-                &t,
-                &tighter_cfg,
-                uncertainty,
-            ),
-        )?;
+        let text = table(
+            &scene,
+            &rows,
+            &r,
+            &reference_cfg,
+            &t,
+            &tighter_cfg,
+            uncertainty,
+        );
+        atelier_fabric::files::write_atomic(&md, text.as_bytes())?;
         let pic = out.join(format!("tradeoff_{}.png", scene.name));
         png(&pic, (1300, 850), |area| {
             draw(area, &scene, &rows, uncertainty)

@@ -41,6 +41,25 @@ pub fn png(
     }
 }
 
+/// Which of the `(wall time, error)` points lie on the Pareto front: no other point has both a
+/// smaller wall time and a smaller error (points without an error are never on it).
+pub fn pareto_front(points: &[(f64, Option<f64>)]) -> Vec<bool> {
+    let mut order: Vec<usize> = (0..points.len())
+        .filter(|&i| points[i].1.is_some())
+        .collect();
+    order.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0));
+    let mut on = vec![false; points.len()];
+    let mut best = f64::INFINITY;
+    for i in order {
+        let e = points[i].1.unwrap_or(f64::INFINITY);
+        if e < best {
+            best = e;
+            on[i] = true;
+        }
+    }
+    on
+}
+
 /// A qualitative palette (Okabe–Ito, colour-blind safe).
 pub const PALETTE: [RGBColor; 7] = [
     RGBColor(0, 114, 178),
@@ -135,4 +154,25 @@ fn trim(x: f64) -> String {
 pub fn to_rgb(c: [f64; 3]) -> RGBColor {
     let [r, g, b] = atelier::picture::to_bytes(c);
     RGBColor(r, g, b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pareto_front_keeps_the_points_nothing_beats() {
+        let points = [
+            (1.0, Some(10.0)),
+            (2.0, Some(12.0)),
+            (3.0, Some(5.0)),
+            (4.0, None),
+            (5.0, Some(1.0)),
+            (0.5, None),
+        ];
+        assert_eq!(
+            pareto_front(&points),
+            vec![true, false, true, false, true, false]
+        );
+    }
 }
