@@ -43,6 +43,8 @@ pub(crate) struct LongRange {
     /// first; `count[i]` of them are used.
     slots: Vec<[(u32, f64); PER_NODE]>,
     count: Vec<u8>,
+    /// The pins' positions at the end of the step (scratch of [`LongRange::project`]).
+    anchors: Vec<V3>,
 }
 
 #[derive(PartialEq)]
@@ -139,13 +141,14 @@ impl LongRange {
             pinned: cloth.pins().iter().map(|p| p.node).collect(),
             slots,
             count,
+            anchors: Vec::new(),
         }
     }
 
     /// Hold every attached node's end-of-step position `x + v·Δt` within `(1 + slack)` times its
     /// rest distance from each of its pins' positions at `t_end`, by changing its velocity.
     pub(crate) fn project(
-        &self,
+        &mut self,
         cloth: &Cloth,
         positions: &[V3],
         vel: &mut [V3],
@@ -153,16 +156,19 @@ impl LongRange {
         dt: f64,
         slack: f64,
     ) {
-        let anchors: Vec<V3> = cloth.pins().iter().map(|p| p.position(t_end)).collect();
+        self.anchors.clear();
+        self.anchors
+            .extend(cloth.pins().iter().map(|p| p.position(t_end)));
+        let (anchors, slots, counts) = (&self.anchors, &self.slots, &self.count);
         let scale = 1.0 + slack;
         let node = |(i, v): (usize, &mut V3)| {
-            let count = self.count[i] as usize;
+            let count = counts[i] as usize;
             if count == 0 {
                 return;
             }
             let mut x = positions[i] + *v * dt;
             let mut moved = false;
-            for &(k, rest) in &self.slots[i][..count] {
+            for &(k, rest) in &slots[i][..count] {
                 let c = anchors[k as usize];
                 let d = x - c;
                 let bound = rest * scale;

@@ -1722,7 +1722,7 @@ impl Solver {
             s.vel_prev[i] = v;
         }
         if s.long_range_on
-            && let Some(lr) = &s.long_range
+            && let Some(lr) = &mut s.long_range
         {
             lr.project(
                 cloth,
