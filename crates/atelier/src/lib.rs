@@ -19,6 +19,7 @@ pub mod scene;
 pub mod sewing;
 pub mod simulation;
 pub mod strip;
+pub mod tryon;
 pub mod validate;
 pub mod wet;
 

@@ -33,6 +33,12 @@ impl Fit {
             centre: [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])],
         }
     }
+
+    /// A fitting of `scale` pixels per metre with the view point `centre` at the picture's
+    /// centre.
+    pub fn with_scale(scale: f64, centre: [f64; 2]) -> Self {
+        Self { scale, centre }
+    }
 }
 
 /// View coordinates of a point: (screen x to the right, screen y up, depth towards the camera).
@@ -58,7 +64,8 @@ pub fn screen_box(points: &[[f64; 3]], view: View) -> ([f64; 2], [f64; 2]) {
     (lo, hi)
 }
 
-/// Render: RGB per pixel (`None` = background), `w × h`, row 0 at the top.
+/// Render: RGB per pixel (`None` = background), `w × h`, row 0 at the top. Each triangle is
+/// shaded by how squarely it faces the viewer.
 pub fn render(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -68,34 +75,86 @@ pub fn render(
     w: usize,
     h: usize,
 ) -> Vec<Option<[f64; 3]>> {
-    let project = |p: [f64; 3]| -> [f64; 3] {
-        let q = to_view(p, view);
+    render_lit(positions, triangles, colour, view, fit, (w, h), None)
+}
+
+/// [`render`] with a light: with `light` (a direction in the view's frame — screen x right,
+/// y up, z towards the viewer — pointing towards the light) a triangle's shade is
+/// `0.3 + 0.7 · max(0, n · l)`; without, `0.25 + 0.75 · n_z` (lit from the viewer).
+pub fn render_lit(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    colour: &dyn Fn(usize) -> [f64; 3],
+    view: View,
+    fit: Fit,
+    (w, h): (usize, usize),
+    light: Option<[f64; 3]>,
+) -> Vec<Option<[f64; 3]>> {
+    let view_points: Vec<[f64; 3]> = positions.iter().map(|&p| to_view(p, view)).collect();
+    let ids = rasterise(&view_points, triangles, fit, w, h);
+    let light = light.map(|l| {
+        let n = dot(l, l).sqrt().max(1e-300);
+        l.map(|v| v / n)
+    });
+    let shades: Vec<f64> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|k| view_points[k as usize]);
+            let n = cross(sub(b, a), sub(c, a));
+            let len = dot(n, n).sqrt().max(1e-300);
+            match light {
+                None => 0.25 + 0.75 * n[2] / len,
+                Some(l) => 0.3 + 0.7 * (dot(n, l) / len).max(0.0),
+            }
+        })
+        .collect();
+    ids.iter()
+        .map(|id| id.map(|t| colour(t as usize).map(|v| v * shades[t as usize])))
+        .collect()
+}
+
+/// The front-most triangle at each pixel centre (`None`: nothing), `w × h`, row 0 at the top,
+/// of points already in a view's frame (screen x right, y up, depth towards the viewer).
+/// Triangles facing away from the viewer are skipped.
+pub fn rasterise(
+    view_points: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    fit: Fit,
+    w: usize,
+    h: usize,
+) -> Vec<Option<u32>> {
+    let mut depth = vec![f64::NEG_INFINITY; w * h];
+    let mut out = vec![None; w * h];
+    if w == 0 || h == 0 {
+        return out;
+    }
+    let project = |q: [f64; 3]| -> [f64; 3] {
         [
             0.5 * w as f64 + (q[0] - fit.centre[0]) * fit.scale,
             0.5 * h as f64 - (q[1] - fit.centre[1]) * fit.scale,
             q[2],
         ]
     };
-    let mut depth = vec![f64::NEG_INFINITY; w * h];
-    let mut out = vec![None; w * h];
     for (ti, t) in triangles.iter().enumerate() {
-        let [a, b, c] = t.map(|k| to_view(positions[k as usize], view));
+        let [a, b, c] = t.map(|k| view_points[k as usize]);
         let n = cross(sub(b, a), sub(c, a));
-        let len = dot(n, n).sqrt();
-        if len == 0.0 || n[2] <= 0.0 {
+        if dot(n, n) == 0.0 || n[2] <= 0.0 || !n[2].is_finite() {
             continue;
         }
-        let shade = 0.25 + 0.75 * n[2] / len;
-        let rgb = colour(ti).map(|v| v * shade);
-        let [pa, pb, pc] = t.map(|k| project(positions[k as usize]));
-        let x0 = pa[0].min(pb[0]).min(pc[0]).floor().max(0.0) as usize;
-        let x1 = (pa[0].max(pb[0]).max(pc[0]).ceil().max(0.0) as usize).min(w - 1);
-        let y0 = pa[1].min(pb[1]).min(pc[1]).floor().max(0.0) as usize;
-        let y1 = (pa[1].max(pb[1]).max(pc[1]).ceil().max(0.0) as usize).min(h - 1);
+        let [pa, pb, pc] = [a, b, c].map(project);
         let area = edge(pa, pb, pc);
         if area.abs() < 1e-12 {
             continue;
         }
+        let (xl, xh) = (pa[0].min(pb[0]).min(pc[0]), pa[0].max(pb[0]).max(pc[0]));
+        let (yl, yh) = (pa[1].min(pb[1]).min(pc[1]), pa[1].max(pb[1]).max(pc[1]));
+        if xh < 0.0 || yh < 0.0 || xl > w as f64 || yl > h as f64 {
+            continue;
+        }
+        let x0 = xl.floor().max(0.0) as usize;
+        let x1 = (xh.ceil().max(0.0) as usize).min(w - 1);
+        let y0 = yl.floor().max(0.0) as usize;
+        let y1 = (yh.ceil().max(0.0) as usize).min(h - 1);
         for y in y0..=y1 {
             for x in x0..=x1 {
                 let q = [x as f64 + 0.5, y as f64 + 0.5, 0.0];
@@ -111,7 +170,7 @@ pub fn render(
                 let k = y * w + x;
                 if z > depth[k] {
                     depth[k] = z;
-                    out[k] = Some(rgb);
+                    out[k] = Some(ti as u32);
                 }
             }
         }

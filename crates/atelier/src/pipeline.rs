@@ -67,7 +67,11 @@ pub fn run_garment(
     base: &Path,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GarmentRun, SceneError> {
-    let scene = Scene::load(spec, base)?;
+    run_scene(Scene::load(spec, base)?, progress)
+}
+
+/// [`run_garment`] on a scene already set up (the try-on builds its own body and motion).
+pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentRun, SceneError> {
     let frame_interval = scene.settings.frame_interval;
     let mut sim = Simulation::new(scene)?;
     let to3 = |v: &[atelier_collide::V3]| -> Vec<[f64; 3]> {

@@ -142,6 +142,9 @@ pub struct Report {
     /// The compared run of a wet scene (absent otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub comparison: Option<Comparison>,
+    /// The try-on's fit and composite (`atelier tryon` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tryon: Option<crate::tryon::TryonInfo>,
 }
 
 impl Report {
@@ -192,6 +195,7 @@ impl Report {
             failure: sim.failure.clone(),
             outputs: Vec::new(),
             comparison: sim.comparison.clone(),
+            tryon: None,
         }
     }
 
@@ -219,7 +223,12 @@ impl Report {
 
     /// Whether the run succeeded: no failure and every expectation met.
     pub fn passed(&self) -> bool {
-        self.failure.is_none() && self.expectations_met
+        self.failure.is_none()
+            && self.expectations_met
+            && self
+                .tryon
+                .as_ref()
+                .is_none_or(|t| t.iou_after >= crate::tryon::LOW_IOU)
     }
 
     /// One line: name, outcome, steps and wall time, and the failure or unmet expectations.

@@ -142,9 +142,31 @@ pub mod outputs {
     pub const PRESSURE: &str = "pressure.png";
     /// String identification: the fitted model (RON).
     pub const PARAMETERS: &str = "parameters.ron";
+    /// Try-on: the garment over the photograph.
+    pub const COMPOSITE: &str = "composite.png";
+    /// Try-on: the fitted silhouette over the mask.
+    pub const OVERLAY: &str = "overlay.png";
+    /// Try-on: the fitted pose, camera and sizes (RON).
+    pub const FITTED_POSE: &str = "fitted_pose.ron";
+    /// Try-on: the pixels the garment covers, white on black.
+    pub const FOOTPRINT: &str = "footprint.png";
     /// Every name above.
-    pub const ALL: [&str; 11] = [
-        REPORT, OBJ, PLY, GLB, PICTURE, TOP, COMPARE, SERIES, TENT, PRESSURE, PARAMETERS,
+    pub const ALL: [&str; 15] = [
+        REPORT,
+        OBJ,
+        PLY,
+        GLB,
+        PICTURE,
+        TOP,
+        COMPARE,
+        SERIES,
+        TENT,
+        PRESSURE,
+        PARAMETERS,
+        COMPOSITE,
+        OVERLAY,
+        FITTED_POSE,
+        FOOTPRINT,
     ];
 }
 
@@ -169,7 +191,21 @@ pub fn run(
     let clock = Instant::now();
     let sim = simulate(scenario, base, progress)?;
     let setup_seconds = (clock.elapsed().as_secs_f64() - sim.wall_seconds).max(0.0);
-    let mut report = Report::new(scenario, file, &sim);
+    write_run(scenario, file, &sim, setup_seconds, out, options, |_| {})
+}
+
+/// Write a simulated run's outputs and its report into `out` (which [`prepare_folder`] made):
+/// what [`run`] does after simulating. `extend` adds to the report before it is written.
+pub fn write_run(
+    scenario: &Scenario,
+    file: Option<&Path>,
+    sim: &Simulated,
+    setup_seconds: f64,
+    out: &Path,
+    options: &RunOptions,
+    extend: impl FnOnce(&mut Report),
+) -> Result<Report, RunError> {
+    let mut report = Report::new(scenario, file, sim);
     report.setup_s = setup_seconds;
     let mut options = *options;
     if !matches!(scenario.kind, ScenarioKind::Garment(_)) {
@@ -186,9 +222,10 @@ pub fn run(
         ScenarioKind::Wet(_) => PictureStyle::Wet,
         ScenarioKind::StringFit(_) => PictureStyle::Tilted,
     };
-    let (written, warnings) = write_outputs(&sim, out, &options, style)?;
+    let (written, warnings) = write_outputs(sim, out, &options, style)?;
     report.outputs = written;
     report.warnings.extend(warnings);
+    extend(&mut report);
     report.write(&out.join(outputs::REPORT))?;
     Ok(report)
 }
@@ -209,7 +246,7 @@ enum PictureStyle {
 
 /// Create the output folder and remove temporary files a killed run may have left beside the
 /// outputs.
-fn prepare_folder(out: &Path) -> Result<(), RunError> {
+pub fn prepare_folder(out: &Path) -> Result<(), RunError> {
     std::fs::create_dir_all(out).map_err(|source| RunError::Output {
         path: out.to_path_buf(),
         source,
@@ -429,9 +466,33 @@ pub fn simulate(
         ScenarioKind::StringFit(spec) => crate::fit::simulate(spec, base)?,
     };
     sim.fabric = fabric.name.clone();
-    trim_non_finite(&mut sim);
+    finish_simulated(&mut sim);
+    progress(1.0);
+    Ok(sim)
+}
+
+/// Simulate a garment scene already set up (nothing is written): the garment kind of
+/// [`simulate`] with the scene's own body and motion.
+pub fn simulate_scene(
+    scene: crate::scene::Scene,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulated, RunError> {
+    let dt = scene.settings.dt;
+    let fabric = scene.garment.fabric.name.clone();
+    let run =
+        crate::pipeline::run_scene(scene, progress).map_err(|e| RunError::Setup(e.to_string()))?;
+    let mut sim = garment_simulated(run, dt);
+    sim.fabric = fabric;
+    finish_simulated(&mut sim);
+    progress(1.0);
+    Ok(sim)
+}
+
+/// The measurements every run reports, and the frames cut at the first non-finite one.
+fn finish_simulated(sim: &mut Simulated) {
+    trim_non_finite(sim);
     sim.metrics
-        .insert("nodes".into(), Some(node_count(&sim) as f64));
+        .insert("nodes".into(), Some(node_count(sim) as f64));
     sim.metrics.insert(
         "cloth_triangles".into(),
         Some(sim.cloth_triangles.len() as f64),
@@ -441,8 +502,6 @@ pub fn simulate(
         .insert("simulated_s".into(), Some(sim.simulated));
     sim.metrics
         .insert("frames".into(), Some(sim.cloth.frames.len() as f64));
-    progress(1.0);
-    Ok(sim)
 }
 
 fn node_count(sim: &Simulated) -> usize {
@@ -486,6 +545,11 @@ fn garment(
     progress: &mut dyn FnMut(f64),
 ) -> Result<Simulated, RunError> {
     let run = run_garment(spec, base, progress).map_err(|e| RunError::Setup(e.to_string()))?;
+    Ok(garment_simulated(run, spec.settings.dt))
+}
+
+/// A garment run as a [`Simulated`]: frames, body, metrics and warnings.
+fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
     let mut cloth = Animation::default();
     let mut body = Animation::default();
     for f in &run.frames {
@@ -544,7 +608,7 @@ fn garment(
     put("max_motion_kinetic_energy_j", Some(run.max_motion_energy));
     put("lowest_node_m", lowest);
     put("nodes_below_body", Some(below as f64));
-    Ok(Simulated {
+    Simulated {
         fabric: String::new(),
         cloth_triangles: run.cloth_triangles,
         cloth,
@@ -554,7 +618,7 @@ fn garment(
             motion: body,
         }),
         steps: run.steps,
-        dt: spec.settings.dt,
+        dt,
         simulated: last,
         wall_seconds: run.wall_seconds,
         timings: run.timings,
@@ -565,7 +629,7 @@ fn garment(
         wet: None,
         fit: None,
         comparison: None,
-    })
+    }
 }
 
 /// How far below the body's lowest point a garment's node counts as fallen off it, m.

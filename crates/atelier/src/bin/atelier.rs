@@ -4,6 +4,8 @@
 //!   the 9AR mannequin, then a short walk — into `./atelier-out`.
 //! - `atelier run SCENARIO.ron --out DIR [--threads N] [--frames K]`: run a scenario file.
 //! - `atelier validate FILE…`: check data files.
+//! - `atelier tryon --photo P.png [--mask M.png] --garment G.ron [--pose S.ron] --out DIR`:
+//!   virtual try-on from one photograph.
 //!
 //! Exit status: 0 success; 1 the run could not start or its outputs could not be written (bad
 //! file, missing file, unwritable folder); 2 the run ended early (diverged) or an expectation
@@ -59,6 +61,45 @@ enum Command {
         /// Output folder (created if missing).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
+    },
+    /// Virtual try-on: pose the mannequin to a photograph's silhouette, dress it with a garment
+    /// scenario, move it to the pose and draw the garment over the photograph (docs/tryon.md):
+    /// composite.png, overlay.png, fitted_pose.ron and the run's outputs and report.json in DIR.
+    Tryon {
+        /// The photograph (PNG, 8 bits per sample).
+        #[arg(long, value_name = "PHOTO.png")]
+        photo: PathBuf,
+        /// The person's mask (PNG, white on black, the photograph's size); without it the
+        /// photograph's plain background is segmented.
+        #[arg(long, value_name = "MASK.png")]
+        mask: Option<PathBuf>,
+        /// The garment: a scenario file of kind Garment.
+        #[arg(long, value_name = "GARMENT.ron")]
+        garment: PathBuf,
+        /// A start pose (RON: joints, optionally camera and sizes); default the standard pose.
+        #[arg(long, value_name = "START.ron")]
+        pose: Option<PathBuf>,
+        /// The camera's direction round the vertical, degrees (0 from the front, 90 from the
+        /// body's left).
+        #[arg(
+            long,
+            value_name = "DEG",
+            default_value_t = 0.0,
+            allow_negative_numbers = true
+        )]
+        yaw: f64,
+        /// The person's height, cm (default: the body description's).
+        #[arg(long, value_name = "CM")]
+        height: Option<f64>,
+        /// Direction towards the light in the body frame, `x,y,z` (x the body's left, y up, z
+        /// forward).
+        #[arg(long, value_name = "X,Y,Z", value_parser = parse_light, allow_negative_numbers = true)]
+        light: Option<[f64; 3]>,
+        /// Output folder (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        #[command(flatten)]
+        options: Options,
     },
     /// Check fabric, pattern, garment, body, motion, range side and scenario files (RON) and
     /// body meshes (OBJ, PLY); print each problem with file:line:column and field.
@@ -117,6 +158,26 @@ fn main() -> ExitCode {
             }
         },
         Some(Command::Validate { files }) => validate(&files),
+        Some(Command::Tryon {
+            photo,
+            mask,
+            garment,
+            pose,
+            yaw,
+            height,
+            light,
+            out,
+            options,
+        }) => {
+            let mut inputs = atelier::tryon::TryonInputs::new(photo, mask, garment);
+            inputs.pose = pose;
+            inputs.yaw_deg = yaw;
+            inputs.height_cm = height;
+            if let Some(l) = light {
+                inputs.light = l;
+            }
+            tryon(&inputs, &out, options)
+        }
         Some(Command::Fit { observations, out }) => {
             match atelier::fit::fit_cloth(&observations, &out) {
                 Ok(report) => {
@@ -177,17 +238,7 @@ fn run_scenario(
             .map_or(FrameSelection::All, |k| FrameSelection::AtMost(k as usize)),
         ..RunOptions::default()
     };
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = indicatif::ProgressBar::new(1000);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} [{elapsed_precise}] {wide_bar} {percent:>3}% (eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar.set_message(scenario.name.clone());
-        bar
-    });
+    let bar = progress_bar(&scenario.name);
     let mut progress = |f: f64| {
         if let Some(b) = &bar {
             b.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
@@ -217,6 +268,96 @@ fn run_scenario(
             ExitCode::FAILURE
         }
     }
+}
+
+/// `x,y,z`: three finite numbers, not all zero.
+fn parse_light(text: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|s| s.trim().parse::<f64>().map_err(|e| format!("`{s}`: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) && v.iter().any(|&c| c != 0.0) => {
+            Ok([x, y, z])
+        }
+        _ => Err(format!(
+            "`{text}`: give three finite numbers x,y,z, not all zero"
+        )),
+    }
+}
+
+fn tryon(inputs: &atelier::tryon::TryonInputs, out: &Path, options: Options) -> ExitCode {
+    if let Some(n) = options.threads
+        && let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(usize::from(n))
+            .build_global()
+    {
+        eprintln!("atelier: cannot start {n} threads: {e}");
+        return ExitCode::FAILURE;
+    }
+    let run_options = RunOptions {
+        frames: options
+            .frames
+            .map_or(FrameSelection::All, |k| FrameSelection::AtMost(k as usize)),
+        ..RunOptions::default()
+    };
+    let bar = progress_bar("tryon");
+    let mut progress = |f: f64| {
+        if let Some(b) = &bar {
+            b.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
+        }
+    };
+    let result = atelier::tryon::tryon(inputs, out, &run_options, &mut progress);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    match result {
+        Ok(report) => {
+            let fit = report.tryon.as_ref().map_or(String::new(), |t| {
+                format!(
+                    "; silhouette overlap {:.3} → {:.3} (fit {:.1} s)",
+                    t.iou_before, t.iou_after, t.fit_s
+                )
+            });
+            let line = format!(
+                "{}{fit} (outputs in {})",
+                report.summary_line(),
+                out.display()
+            );
+            if report.passed() {
+                #[allow(clippy::print_stdout)]
+                {
+                    println!("{line}");
+                }
+                ExitCode::SUCCESS
+            } else {
+                eprintln!("atelier: {line}");
+                for w in &report.warnings {
+                    eprintln!("atelier: warning: {w}");
+                }
+                ExitCode::from(2)
+            }
+        }
+        Err(e) => {
+            eprintln!("atelier: tryon: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// A progress bar on a terminal (none otherwise).
+fn progress_bar(name: &str) -> Option<indicatif::ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} [{elapsed_precise}] {wide_bar} {percent:>3}% (eta {eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_message(name.to_string());
+        bar
+    })
 }
 
 fn validate(files: &[PathBuf]) -> ExitCode {

@@ -1,0 +1,228 @@
+//! The photograph's camera and the mannequin's silhouette as it sees it.
+//!
+//! The camera is orthographic and level (no tilt, no roll): it looks horizontally at the body
+//! from `yaw_deg` round the vertical axis (0: from the front; 90: from the body's left), and
+//! maps a point to pixels by a scale and the pixel of the world origin (the point between the
+//! mannequin's soles). The silhouette is rendered with `ss × ss` samples per pixel, so its
+//! coverage moves with the parameters in steps of `1/ss²` — fine enough for the differences a
+//! Levenberg–Marquardt Jacobian takes.
+
+use serde::{Deserialize, Serialize};
+
+use crate::picture::{Fit, rasterise};
+
+/// An orthographic, level camera.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    /// Direction round the vertical axis, degrees: 0 from the front, 90 from the body's left.
+    pub yaw_deg: f64,
+    /// Pixels per metre.
+    pub scale: f64,
+    /// Pixel (column, row; row 0 at the top) of the world origin.
+    pub origin_px: [f64; 2],
+}
+
+impl Camera {
+    /// A point in the camera's view frame: (across to the right, up, towards the camera), m.
+    pub fn view(&self, p: [f64; 3]) -> [f64; 3] {
+        let (s, c) = self.yaw_deg.to_radians().sin_cos();
+        [p[0] * c - p[2] * s, p[1], p[0] * s + p[2] * c]
+    }
+
+    /// A direction given in the body frame turned into the view frame.
+    pub fn view_direction(&self, d: [f64; 3]) -> [f64; 3] {
+        self.view(d)
+    }
+
+    /// The pixel (column, row) a point projects to.
+    pub fn pixel(&self, p: [f64; 3]) -> [f64; 2] {
+        let q = self.view(p);
+        [
+            self.origin_px[0] + self.scale * q[0],
+            self.origin_px[1] - self.scale * q[1],
+        ]
+    }
+
+    /// The picture fitting of this camera for a `w × h` picture at `ss` samples per pixel side
+    /// (the fitting of `w·ss × h·ss` samples).
+    pub fn fit(&self, w: usize, h: usize, ss: usize) -> Fit {
+        // u = w/2 + (x − c₀)·s = origin + s·x  ⇒  c₀ = (w/2 − origin)/s (and likewise for v).
+        let c0 = (0.5 * w as f64 - self.origin_px[0]) / self.scale;
+        let c1 = (self.origin_px[1] - 0.5 * h as f64) / self.scale;
+        Fit::with_scale(self.scale * ss as f64, [c0, c1])
+    }
+}
+
+/// The fraction of each pixel of a `w × h` picture the mesh covers, from `ss × ss` samples per
+/// pixel (row 0 at the top).
+pub fn coverage(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    camera: &Camera,
+    (w, h): (usize, usize),
+    ss: usize,
+) -> Vec<f64> {
+    let view: Vec<[f64; 3]> = positions.iter().map(|&p| camera.view(p)).collect();
+    let (sw, sh) = (w * ss, h * ss);
+    let ids = rasterise(&view, triangles, camera.fit(w, h, ss), sw, sh);
+    let mut out = vec![0.0; w * h];
+    let per = 1.0 / (ss * ss) as f64;
+    for y in 0..sh {
+        let row = (y / ss) * w;
+        for x in 0..sw {
+            if ids[y * sw + x].is_some() {
+                out[row + x / ss] += per;
+            }
+        }
+    }
+    out
+}
+
+/// A separable Gaussian blur of standard deviation `sigma` pixels (kernel cut at 3σ; outside
+/// the picture counts as 0). `sigma ≤ 0` returns the picture unchanged.
+pub fn blur(image: &[f64], (w, h): (usize, usize), sigma: f64) -> Vec<f64> {
+    if sigma <= 0.0 {
+        return image.to_vec();
+    }
+    let r = (3.0 * sigma).ceil() as isize;
+    let kernel: Vec<f64> = (-r..=r)
+        .map(|k| (-0.5 * (k as f64 / sigma).powi(2)).exp())
+        .collect();
+    let total: f64 = kernel.iter().sum();
+    let kernel: Vec<f64> = kernel.iter().map(|v| v / total).collect();
+    let pass = |src: &[f64], along_x: bool| -> Vec<f64> {
+        let mut dst = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let mut acc = 0.0;
+                for (j, kv) in kernel.iter().enumerate() {
+                    let d = j as isize - r;
+                    let (xx, yy) = if along_x {
+                        (x as isize + d, y as isize)
+                    } else {
+                        (x as isize, y as isize + d)
+                    };
+                    if xx >= 0 && yy >= 0 && (xx as usize) < w && (yy as usize) < h {
+                        acc += kv * src[yy as usize * w + xx as usize];
+                    }
+                }
+                dst[y * w + x] = acc;
+            }
+        }
+        dst
+    };
+    pass(&pass(image, true), false)
+}
+
+/// A picture reduced by an integer `factor` (each output pixel the mean of `factor²` input
+/// pixels; a partial block at the right or bottom edge averages what it has).
+pub fn reduce(image: &[f64], (w, h): (usize, usize), factor: usize) -> (Vec<f64>, usize, usize) {
+    let (rw, rh) = (w.div_ceil(factor), h.div_ceil(factor));
+    let mut sum = vec![0.0; rw * rh];
+    let mut count = vec![0.0f64; rw * rh];
+    for y in 0..h {
+        for x in 0..w {
+            let k = (y / factor) * rw + x / factor;
+            sum[k] += image[y * w + x];
+            count[k] += 1.0;
+        }
+    }
+    let out = sum.iter().zip(&count).map(|(s, c)| s / c).collect();
+    (out, rw, rh)
+}
+
+/// Intersection over union of two masks given as coverage (a pixel counts when ≥ ½).
+pub fn iou(a: &[f64], b: &[f64]) -> f64 {
+    let (mut inter, mut union) = (0usize, 0usize);
+    for (&p, &q) in a.iter().zip(b) {
+        let (p, q) = (p >= 0.5, q >= 0.5);
+        inter += usize::from(p && q);
+        union += usize::from(p || q);
+    }
+    if union == 0 {
+        0.0
+    } else {
+        inter as f64 / union as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit square (two triangles, facing +z) at the origin.
+    fn square() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        (
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+    }
+
+    #[test]
+    fn coverage_of_a_square_is_its_area_in_pixels() {
+        let (p, t) = square();
+        // 10 px per metre, the origin at pixel (3.25, 15.5): the square spans 3.25..13.25 across
+        // and 5.5..15.5 down; its area is exactly 100 px².
+        let cam = Camera {
+            yaw_deg: 0.0,
+            scale: 10.0,
+            origin_px: [3.25, 15.5],
+        };
+        let c = coverage(&p, &t, &cam, (20, 20), 4);
+        let area: f64 = c.iter().sum();
+        assert!((area - 100.0).abs() < 1e-9, "area {area}");
+        // The columns cut by the left edge are a quarter covered... sampled at 4 per side:
+        // column 3 spans 3..4, the edge at 3.25 leaves 3 of its 4 sample columns inside.
+        assert!((c[10 * 20 + 3] - 0.75).abs() < 1e-12, "{}", c[10 * 20 + 3]);
+        // Seen from the side (yaw 90°), the square is edge-on: nothing.
+        let side = Camera {
+            yaw_deg: 90.0,
+            ..cam
+        };
+        assert!(
+            coverage(&p, &t, &side, (20, 20), 4)
+                .iter()
+                .all(|&v| v == 0.0)
+        );
+        // From behind the square faces away: nothing either (one-sided, as a closed body's
+        // back faces are).
+        let back = Camera {
+            yaw_deg: 180.0,
+            ..cam
+        };
+        assert!(
+            coverage(&p, &t, &back, (20, 20), 4)
+                .iter()
+                .all(|&v| v == 0.0)
+        );
+    }
+
+    #[test]
+    fn blur_keeps_the_total_and_reduce_keeps_the_mean() {
+        let mut img = vec![0.0; 31 * 31];
+        img[15 * 31 + 15] = 1.0;
+        let b = blur(&img, (31, 31), 2.0);
+        let total: f64 = b.iter().sum();
+        assert!((total - 1.0).abs() < 1e-12, "{total}");
+        // Symmetric, peaked at the centre, its variance along x σ² (to the cut at 3σ).
+        assert!((b[15 * 31 + 14] - b[15 * 31 + 16]).abs() < 1e-15);
+        let var: f64 = (0..31)
+            .map(|x| {
+                let col: f64 = (0..31).map(|y| b[y * 31 + x]).sum();
+                col * (x as f64 - 15.0).powi(2)
+            })
+            .sum();
+        assert!((var - 4.0).abs() < 0.1, "variance {var}");
+        let (r, rw, rh) = reduce(&b, (31, 31), 4);
+        assert_eq!((rw, rh), (8, 8));
+        // 31 = 7·4 + 3: the last block averages 3 columns; the total of means × counts holds.
+        assert!(r.iter().all(|v| v.is_finite()));
+        assert!((iou(&[1.0, 1.0, 0.0, 0.0], &[1.0, 0.0, 1.0, 0.0]) - 1.0 / 3.0).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,119 @@
+//! The garment over the photograph (thesis §6.2, step 3): the dressed mannequin rendered with
+//! the fitted camera, 2 × 2 samples per pixel; where the garment is the nearest surface it is
+//! drawn, shaded by the light; where the mannequin's body is nearest, or nothing, the
+//! photograph shows. So the body parts the garment covers are hidden and those it does not
+//! (face, hands, legs) are the photograph's own, and every pixel outside the garment's
+//! footprint is the photograph's, bit for bit.
+
+use super::camera::Camera;
+use super::image::{Mask, Photo};
+use crate::picture::{MeshRef, rasterise};
+
+/// A composite and where the garment is.
+#[derive(Clone, Debug)]
+pub struct Composite {
+    /// Samples, in the photograph's layout (its channels).
+    pub data: Vec<u8>,
+    /// Pixels the garment covers at least one sample of.
+    pub footprint: Vec<bool>,
+}
+
+/// Draw the garment (`cloth`, both sides) over `photo`, hidden where the `body` is nearer the
+/// camera, coloured `colour` and lit from `light` (a direction in the body frame towards the
+/// light: x the body's left, y up, z forward).
+pub fn composite(
+    photo: &Photo,
+    camera: &Camera,
+    cloth: MeshRef<'_>,
+    body: MeshRef<'_>,
+    colour: [f64; 3],
+    light: [f64; 3],
+) -> Composite {
+    const SS: usize = 2;
+    let (w, h) = (photo.width, photo.height);
+    let mut points: Vec<[f64; 3]> = cloth.0.iter().map(|&p| camera.view(p)).collect();
+    let mut triangles: Vec<[u32; 3]> = cloth.1.to_vec();
+    triangles.extend(cloth.1.iter().map(|t| [t[0], t[2], t[1]]));
+    let n_cloth = triangles.len();
+    let base = points.len() as u32;
+    points.extend(body.0.iter().map(|&p| camera.view(p)));
+    triangles.extend(body.1.iter().map(|t| t.map(|k| k + base)));
+    let ids = rasterise(&points, &triangles, camera.fit(w, h, SS), w * SS, h * SS);
+    let l = camera.view_direction(light);
+    let ln = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt().max(1e-300);
+    let shade = |t: usize| -> [f64; 3] {
+        let [a, b, c] = triangles[t].map(|k| points[k as usize]);
+        let (u, v) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
+        let lit = ((n[0] * l[0] + n[1] * l[1] + n[2] * l[2]) / (len * ln)).max(0.0);
+        colour.map(|c| c * (0.3 + 0.7 * lit))
+    };
+    let mut data = photo.data.clone();
+    let mut footprint = vec![false; w * h];
+    let ch = photo.channels;
+    for y in 0..h {
+        for x in 0..w {
+            let mut sum = [0.0; 3];
+            let mut k = 0usize;
+            for sy in 0..SS {
+                for sx in 0..SS {
+                    if let Some(t) = ids[(y * SS + sy) * w * SS + x * SS + sx]
+                        && (t as usize) < n_cloth
+                    {
+                        let c = shade(t as usize);
+                        for i in 0..3 {
+                            sum[i] += c[i];
+                        }
+                        k += 1;
+                    }
+                }
+            }
+            if k == 0 {
+                continue;
+            }
+            let p = y * w + x;
+            footprint[p] = true;
+            let n = (SS * SS) as f64;
+            let cover = k as f64 / n;
+            for i in 0..3 {
+                let photo_v = f64::from(photo.data[p * ch + i]) / 255.0;
+                let v = sum[i] / n + (1.0 - cover) * photo_v;
+                data[p * ch + i] = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+            }
+            if ch == 4 {
+                let a = f64::from(photo.data[p * ch + 3]) / 255.0;
+                data[p * ch + 3] = ((cover + (1.0 - cover) * a) * 255.0).round() as u8;
+            }
+        }
+    }
+    Composite { data, footprint }
+}
+
+/// The fit pictured: the photograph faded, the pixels in both the mask and the fitted
+/// silhouette tinted green, in the mask only red, in the silhouette only blue (RGB samples).
+pub fn overlay(photo: &Photo, mask: &Mask, silhouette: &[f64]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(3 * photo.width * photo.height);
+    for (k, (&m, &s)) in mask.data.iter().zip(silhouette).enumerate() {
+        let base = photo.rgb(k).map(|v| 0.5 * f64::from(v) + 0.5 * 235.0);
+        let tint: Option<[f64; 3]> = match (m, s >= 0.5) {
+            (true, true) => Some([60.0, 170.0, 75.0]),
+            (true, false) => Some([220.0, 50.0, 40.0]),
+            (false, true) => Some([40.0, 90.0, 220.0]),
+            (false, false) => None,
+        };
+        let c = match tint {
+            Some(t) => [0, 1, 2].map(|i| 0.45 * base[i] + 0.55 * t[i]),
+            None => base,
+        };
+        out.extend(c.map(|v| v.round().clamp(0.0, 255.0) as u8));
+    }
+    out
+}
