@@ -5,6 +5,7 @@
 
 pub mod camera;
 pub mod composite;
+pub mod examples;
 pub mod image;
 pub mod pose;
 
@@ -307,7 +308,7 @@ pub fn tryon(
 
     let info = info(inputs, &mask, &fit, &fitted, motion_s, &picture);
     let setup = (clock.elapsed().as_secs_f64() - sim.wall_seconds).max(0.0);
-    let warnings = warnings(&mask, &fit);
+    let warnings = fit_warnings(&mask, &fit);
     let report = write_run(
         &scenario,
         Some(&inputs.garment),
@@ -359,7 +360,7 @@ fn info(
 }
 
 /// What the user should know about the fit.
-fn warnings(mask: &Mask, fit: &PoseFit) -> Vec<String> {
+pub fn fit_warnings(mask: &Mask, fit: &PoseFit) -> Vec<String> {
     let mut w = Vec::new();
     if fit.iou_after < LOW_IOU {
         w.push(format!(
