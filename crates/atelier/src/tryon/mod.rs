@@ -295,7 +295,9 @@ pub fn tryon(
         &image::encode(photo.width, photo.height, 3, &footprint).map_err(io)?,
     )?;
     let fitted = PoseFile::from_angles(&fit.angles, Some(fit.camera), Some(fit.sizes));
-    let ron_text = ron::ser::to_string_pretty(&fitted, ron::ser::PrettyConfig::default())
+    let ron_text = ron::Options::default()
+        .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+        .to_string_pretty(&fitted, ron::ser::PrettyConfig::default())
         .map_err(|e| TryonError::Input(format!("the fitted pose does not serialise: {e}")))?;
     write(
         outputs::FITTED_POSE,
