@@ -16,6 +16,8 @@
 //! - `cargo xtask figures tradeoff [--out DIR]` — time against error for the sewn dress and the
 //!   walk: PARTY's accuracy knobs swept, XPBD and mass-spring, against a tight PARTY reference
 //!   (`tradeoff_dress.{md,png}`, `tradeoff_walk.{md,png}`, about 8 minutes).
+//! - `cargo xtask figures tryon [--out DIR]` — the virtual try-on on the synthetic photographs
+//!   (photograph, fitted silhouette, composite; `tryon.md` with overlaps, errors and times).
 //! - `cargo xtask figures fit [--out DIR]` — the string-identification experiments on the
 //!   synthetic objects: Table 1, Fig. 11, Table 3 and the reproduced shapes.
 //! - `cargo xtask bench-report [--out DIR] [--skip STEP…]` — every criterion bench, the
@@ -34,6 +36,7 @@ mod figures_grid_body;
 mod figures_solver;
 mod figures_stability;
 mod figures_tradeoff;
+mod figures_tryon;
 mod figures_wet;
 mod plot;
 mod run_scenarios;
@@ -109,6 +112,9 @@ enum FigureSet {
     /// Time against error for the sewn dress and the walk: PARTY's knobs swept, XPBD and
     /// mass-spring, against a tight PARTY reference (about 8 minutes).
     Tradeoff,
+    /// Virtual try-on on the synthetic photographs: photograph, fit, composite; the frontal
+    /// ambiguity; a segmented photograph (about a minute).
+    Tryon,
 }
 
 /// A figure set's entry point: draw everything from the repository root into a folder, return
@@ -132,6 +138,7 @@ fn main() -> Result<()> {
                 FigureSet::Fit => ("fit", figures_fit::draw_all),
                 FigureSet::Stability => ("stability", figures_stability::draw_all),
                 FigureSet::Tradeoff => ("tradeoff", figures_tradeoff::draw_all),
+                FigureSet::Tryon => ("tryon", figures_tryon::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;

@@ -9,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::picture::{Fit, rasterise};
+use crate::picture::Fit;
 
 /// An orthographic, level camera.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -55,7 +55,9 @@ impl Camera {
 }
 
 /// The fraction of each pixel of a `w × h` picture the mesh covers, from `ss × ss` samples per
-/// pixel (row 0 at the top).
+/// pixel (row 0 at the top). Triangles facing away from the camera are skipped (a closed
+/// surface's front faces cover its silhouette); each front triangle is filled row by row
+/// between its edges, a sample counting when its centre lies inside or on an edge.
 pub fn coverage(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -63,16 +65,76 @@ pub fn coverage(
     (w, h): (usize, usize),
     ss: usize,
 ) -> Vec<f64> {
-    let view: Vec<[f64; 3]> = positions.iter().map(|&p| camera.view(p)).collect();
     let (sw, sh) = (w * ss, h * ss);
-    let ids = rasterise(&view, triangles, camera.fit(w, h, ss), sw, sh);
     let mut out = vec![0.0; w * h];
+    if sw == 0 || sh == 0 {
+        return out;
+    }
+    let k = ss as f64;
+    // Sample coordinates: column = (origin + scale·x)·ss, row = (origin − scale·y)·ss.
+    let points: Vec<[f64; 3]> = positions
+        .iter()
+        .map(|&p| {
+            let q = camera.view(p);
+            [
+                (camera.origin_px[0] + camera.scale * q[0]) * k,
+                (camera.origin_px[1] - camera.scale * q[1]) * k,
+                q[2],
+            ]
+        })
+        .collect();
+    let mut samples = vec![0u8; sw * sh];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| points[i as usize]);
+        // Rows grow downwards, so a triangle facing the camera (counter-clockwise in the view
+        // frame) is clockwise here: its signed area is negative.
+        let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        // (NaN coordinates fail the test too.)
+        if area.is_nan() || area >= 0.0 {
+            continue;
+        }
+        let y_lo = a[1].min(b[1]).min(c[1]);
+        let y_hi = a[1].max(b[1]).max(c[1]);
+        let r0 = (y_lo - 0.5).ceil().max(0.0) as usize;
+        let r1 = (y_hi - 0.5).floor();
+        if r1 < 0.0 {
+            continue;
+        }
+        let r1 = (r1 as usize).min(sh - 1);
+        let edges = [(a, b), (b, c), (c, a)];
+        for row in r0..=r1 {
+            let yc = row as f64 + 0.5;
+            let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+            let mut empty = false;
+            for (p, q) in edges {
+                // Inside: (q − p) × (s − p) ≤ 0 (clockwise), linear in the sample's x.
+                let slope = -(q[1] - p[1]);
+                let constant = (q[0] - p[0]) * (yc - p[1]) + (q[1] - p[1]) * p[0];
+                if slope > 0.0 {
+                    hi = hi.min(-constant / slope);
+                } else if slope < 0.0 {
+                    lo = lo.max(-constant / slope);
+                } else if constant > 0.0 {
+                    empty = true;
+                }
+            }
+            if empty || lo > hi {
+                continue;
+            }
+            let c0 = (lo - 0.5).ceil().max(0.0);
+            let c1 = (hi - 0.5).floor().min((sw - 1) as f64);
+            if c1 < c0 {
+                continue;
+            }
+            samples[row * sw + c0 as usize..=row * sw + c1 as usize].fill(1);
+        }
+    }
     let per = 1.0 / (ss * ss) as f64;
-    for y in 0..sh {
-        let row = (y / ss) * w;
-        for x in 0..sw {
-            if ids[y * sw + x].is_some() {
-                out[row + x / ss] += per;
+    for (y, row) in samples.chunks_exact(sw).enumerate() {
+        let base = (y / ss) * w;
+        for (x, &v) in row.iter().enumerate() {
+            if v != 0 {
+                out[base + x / ss] += per;
             }
         }
     }
@@ -91,28 +153,35 @@ pub fn blur(image: &[f64], (w, h): (usize, usize), sigma: f64) -> Vec<f64> {
         .collect();
     let total: f64 = kernel.iter().sum();
     let kernel: Vec<f64> = kernel.iter().map(|v| v / total).collect();
-    let pass = |src: &[f64], along_x: bool| -> Vec<f64> {
-        let mut dst = vec![0.0; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let mut acc = 0.0;
-                for (j, kv) in kernel.iter().enumerate() {
-                    let d = j as isize - r;
-                    let (xx, yy) = if along_x {
-                        (x as isize + d, y as isize)
-                    } else {
-                        (x as isize, y as isize + d)
-                    };
-                    if xx >= 0 && yy >= 0 && (xx as usize) < w && (yy as usize) < h {
-                        acc += kv * src[yy as usize * w + xx as usize];
-                    }
-                }
-                dst[y * w + x] = acc;
+    // Along the rows of a `cols`-wide picture, zero-padded by r: no bounds tests inside.
+    let pass = |src: &[f64], cols: usize| -> Vec<f64> {
+        let r = r as usize;
+        let mut padded = vec![0.0; cols + 2 * r];
+        let mut dst = vec![0.0; src.len()];
+        for (row_in, row_out) in src.chunks_exact(cols).zip(dst.chunks_exact_mut(cols)) {
+            padded[r..r + cols].copy_from_slice(row_in);
+            for (x, out) in row_out.iter_mut().enumerate() {
+                *out = padded[x..x + kernel.len()]
+                    .iter()
+                    .zip(&kernel)
+                    .map(|(v, k)| v * k)
+                    .sum();
             }
         }
         dst
     };
-    pass(&pass(image, true), false)
+    let transpose = |src: &[f64], cols: usize, rows: usize| -> Vec<f64> {
+        let mut dst = vec![0.0; src.len()];
+        for y in 0..rows {
+            for x in 0..cols {
+                dst[x * rows + y] = src[y * cols + x];
+            }
+        }
+        dst
+    };
+    let across = pass(image, w);
+    let down = pass(&transpose(&across, w, h), h);
+    transpose(&down, h, w)
 }
 
 /// A picture reduced by an integer `factor` (each output pixel the mean of `factor²` input

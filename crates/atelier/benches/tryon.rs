@@ -1,0 +1,98 @@
+//! Benchmarks of the virtual try-on (issue 11): the synthetic `arms_raised` photograph of
+//! `atelier::tryon::examples` (420 × 460 px, the person 380 px tall).
+//!
+//! - `tryon/fit`: the whole pose fit from the standard pose (limb search, then three levels of
+//!   Levenberg–Marquardt), as `atelier tryon` runs it.
+//! - `tryon/silhouette`: one residual evaluation's render at the finest level — the mannequin
+//!   built at a size, posed, its silhouette rendered at 4 × 4 samples per pixel.
+//! - `tryon/composite`: the dressed, posed state drawn over the photograph (2 × 2 samples).
+//!
+//! `cargo test --benches` runs each once (criterion's test mode).
+
+use std::hint::black_box;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use atelier::run::simulate_scene;
+use atelier::scenario::{Scenario, ScenarioKind};
+use atelier::tryon::camera::coverage;
+use atelier::tryon::composite::composite;
+use atelier::tryon::examples::examples;
+use atelier::tryon::motion_to;
+use atelier::tryon::pose::{FitOptions, PoseFile, fit_pose, posed_mannequin, synthetic_photo};
+use atelier::{Garment, Scene};
+use atelier_body::Mannequin;
+use atelier_body::build::jis_9ar_description;
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn tryon(c: &mut Criterion) {
+    let e = examples()
+        .into_iter()
+        .find(|e| e.name == "arms_raised")
+        .expect("example");
+    let d = jis_9ar_description();
+    let (photo, mask) = synthetic_photo(&d, &e.sizes, &e.angles, &e.camera, e.size).expect("photo");
+    let mut g = c.benchmark_group("tryon");
+    g.sample_size(10);
+    g.measurement_time(Duration::from_secs(60));
+    let options = FitOptions {
+        description: d.clone(),
+        height_cm: e.sizes.height_cm,
+        yaw_deg: e.camera.yaw_deg,
+        start: PoseFile::default(),
+    };
+    g.bench_function("fit", |b| {
+        b.iter(|| black_box(fit_pose(&mask, &options).expect("fit")))
+    });
+    g.finish();
+    let mut g = c.benchmark_group("tryon");
+    g.bench_function("silhouette", |b| {
+        b.iter(|| {
+            let (points, triangles) = posed_mannequin(&d, &e.sizes, &e.angles).expect("posed");
+            black_box(coverage(&points, &triangles, &e.camera, e.size, 4))
+        })
+    });
+    // The dressed state: the sewn dress moved to the example's pose (the truth, not a fit).
+    let scenarios = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");
+    let scenario = Scenario::load(&scenarios.join("dress_sewn.ron")).expect("scenario");
+    let ScenarioKind::Garment(spec) = &scenario.kind else {
+        panic!("a garment scenario")
+    };
+    let mannequin = Mannequin::from_description(&d, &e.sizes).expect("mannequin");
+    let (motion, duration) = motion_to(&e.angles, &mannequin).expect("motion");
+    let garment = Garment::load(
+        &scenarios.join(&spec.garment),
+        &scenarios.join(&spec.fabric),
+        spec.placements.clone(),
+        spec.place,
+    )
+    .expect("garment");
+    let mut settings = spec.settings.clone();
+    settings.motion_time = duration + atelier::tryon::HOLD_S;
+    let scene = Scene::new(garment, mannequin, Some(motion), settings).expect("scene");
+    let sim = simulate_scene(scene, &mut |_| {}).expect("simulated");
+    let cloth = sim.cloth.frames.last().expect("frame").clone();
+    let solid = sim.solid.as_ref().expect("body");
+    let body = solid.motion.frames.last().expect("frame").clone();
+    g.bench_function("composite", |b| {
+        b.iter(|| {
+            black_box(composite(
+                &photo,
+                &e.camera,
+                (&cloth, &sim.cloth_triangles),
+                (&body, &solid.triangles),
+                atelier::picture::CLOTH,
+                atelier::tryon::DEFAULT_LIGHT,
+            ))
+        })
+    });
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    // No HTML plots: criterion's own plots find no font (see the garment bench).
+    config = Criterion::default().without_plots();
+    targets = tryon
+}
+criterion_main!(benches);
