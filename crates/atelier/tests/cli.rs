@@ -520,3 +520,96 @@ fn atelier_fit_prints_the_fitted_rigidity_and_refuses_a_bad_profile() {
     assert!(!bad_out.exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+// ---- atelier tryon -----------------------------------------------------------------------
+
+fn status(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_atelier"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("runs");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn tryon_runs_the_fixture_and_refuses_a_mask_of_another_picture() {
+    let dir = temp_dir("tryon");
+    let out = dir.join("out");
+    let out_s = out.display().to_string();
+    // The README's command: exit 0, one line with the overlap, the outputs written.
+    let (code, stdout, stderr) = status(&[
+        "tryon",
+        "--photo",
+        "fixtures/tryon/arms_raised.png",
+        "--mask",
+        "fixtures/tryon/arms_raised_mask.png",
+        "--garment",
+        "fixtures/scenarios/dress_sewn.ron",
+        "--yaw",
+        "30",
+        "--light",
+        "-0.5,1,1",
+        "--out",
+        &out_s,
+    ]);
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("silhouette overlap 0.2") && stdout.contains("→ 0.99"),
+        "{stdout}"
+    );
+    for name in [
+        "composite.png",
+        "overlay.png",
+        "footprint.png",
+        "fitted_pose.ron",
+        "report.json",
+    ] {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+    let report = std::fs::read_to_string(out.join("report.json")).expect("report");
+    assert!(report.contains("\"light\": [\n      -0.5,"), "{report}");
+    // The other photograph's picture as the mask: not black and white, exit 1, one line, the
+    // file named; the earlier outputs untouched.
+    let before = std::fs::read(out.join("composite.png")).expect("composite");
+    let (code, stdout, stderr) = status(&[
+        "tryon",
+        "--photo",
+        "fixtures/tryon/arms_raised.png",
+        "--mask",
+        "fixtures/tryon/mid_stride.png",
+        "--garment",
+        "fixtures/scenarios/dress_sewn.ron",
+        "--out",
+        &out_s,
+    ]);
+    assert_eq!(code, Some(1), "{stdout}{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("mid_stride.png") && stderr.contains("not a mask"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read(out.join("composite.png")).expect("composite"),
+        before
+    );
+    // A light of zeros is refused by the argument parser.
+    let (code, _, stderr) = status(&[
+        "tryon",
+        "--photo",
+        "p.png",
+        "--garment",
+        "g.ron",
+        "--light",
+        "0,0,0",
+        "--out",
+        &out_s,
+    ]);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("not all zero"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}

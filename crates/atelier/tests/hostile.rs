@@ -235,6 +235,28 @@ proptest! {
     }
 
     #[test]
+    fn tryon_pose_files(edits in prop::collection::vec(edit(), 1..6)) {
+        let base = "(camera: (yaw_deg: 30.0, scale: 240.0, origin_px: (210.0, 435.0)), sizes: (height_cm: 158.0, bust_cm: 88.0, waist_cm: 67.9, hip_cm: 96.5), joints: {\"upper_arm_left\": (-10.0, 0.0, 75.0), \"forearm_left\": (-20.0, 0.0, 0.0)})";
+        let text = mutate(base, &edits);
+        let t = text.clone();
+        guarded("the try-on pose loader", &text, move || load_pose(t));
+    }
+
+    #[test]
+    fn tryon_pictures(flips in prop::collection::vec((any::<usize>(), any::<u8>()), 1..8), cut in any::<usize>(), which in 0usize..2) {
+        let name = ["fixtures/tryon/arms_raised_mask.png", "fixtures/tryon/mid_stride.png"][which];
+        let mut bytes = std::fs::read(loaders::root().join(name)).expect("fixture");
+        for (p, b) in flips {
+            let i = p % bytes.len();
+            bytes[i] = b;
+        }
+        if cut % 3 == 0 {
+            bytes.truncate(cut % (bytes.len() + 1));
+        }
+        guarded("the try-on picture loaders", name, move || load_picture(bytes));
+    }
+
+    #[test]
     fn random_bytes(bytes in prop::collection::vec(any::<u8>(), 0..2048)) {
         let text = String::from_utf8_lossy(&bytes).into_owned();
         for (what, load) in [

@@ -93,7 +93,7 @@ enum Command {
         height: Option<f64>,
         /// Direction towards the light in the body frame, `x,y,z` (x the body's left, y up, z
         /// forward).
-        #[arg(long, value_name = "X,Y,Z", value_parser = parse_light, allow_negative_numbers = true)]
+        #[arg(long, value_name = "X,Y,Z", value_parser = parse_light, allow_hyphen_values = true)]
         light: Option<[f64; 3]>,
         /// Output folder (created if missing).
         #[arg(long, value_name = "DIR")]

@@ -114,6 +114,10 @@ pub struct TryonInfo {
     pub joints: BTreeMap<String, (f64, f64, f64)>,
     /// Length of the motion from the standard pose to the fitted one, s.
     pub motion_s: f64,
+    /// Pixels of the person the fitted mannequin does not cover (red in `overlay.png`): where
+    /// the person is wider than the mannequin, the person can show beside the garment (the
+    /// composite does not paint the photograph's background over them).
+    pub person_outside_mannequin_px: usize,
     /// Pixels of the photograph the garment covers.
     pub garment_pixels: usize,
     /// The light's direction (body frame).
@@ -356,6 +360,12 @@ fn info(
         sizes: fit.sizes,
         joints: fitted.joints.clone(),
         motion_s,
+        person_outside_mannequin_px: mask
+            .data
+            .iter()
+            .zip(&fit.silhouette)
+            .filter(|(m, s)| **m && **s < 0.5)
+            .count(),
         garment_pixels: picture.footprint.iter().filter(|&&b| b).count(),
         light: inputs.light,
     }

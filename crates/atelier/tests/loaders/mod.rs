@@ -155,3 +155,29 @@ pub const CLOTH: &str = r#"ClothObservations(
     base: "base.ron",
     cantilevers: [(direction: Warp, overhang: 0.04, points: [(0.01, 0.0099, 0.001), (0.02, 0.0195, 0.004), (0.03, 0.0285, 0.009), (0.04, 0.037, 0.015)])],
 )"#;
+
+/// A try-on start pose (`--pose`, the format of `fitted_pose.ron`): parse and check.
+pub fn load_pose(text: String) {
+    if let Ok(pose) = atelier_fabric::files::parse_ron::<atelier::tryon::pose::PoseFile>(
+        &text,
+        Path::new("hostile_pose.ron"),
+    ) {
+        let _ = pose.check();
+    }
+}
+
+/// A photograph and a mask (PNG bytes): read the photograph, then the mask against its size and
+/// against a wrong size, and segment the photograph.
+pub fn load_picture(bytes: Vec<u8>) {
+    let dir = scratch("picture");
+    let path = dir.join("p.png");
+    std::fs::write(&path, &bytes).expect("write");
+    if let Ok(photo) = atelier::tryon::image::load_photo(&path) {
+        let _ = atelier::tryon::image::load_mask(&path, (photo.width, photo.height));
+        let _ = atelier::tryon::image::load_mask(&path, (photo.width + 1, photo.height));
+        if photo.width * photo.height <= 1 << 20 {
+            let _ = atelier::tryon::image::segment_plain_background(&photo, 40);
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
