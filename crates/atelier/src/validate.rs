@@ -1,6 +1,6 @@
 //! `atelier validate FILE…`: check atelier's data files — fabrics, patterns, garments, body
-//! descriptions, motions, range-image side files, scenarios (RON) and external bodies (OBJ,
-//! PLY) — and report each problem with file:line:column and field.
+//! descriptions, motions, range-image side files, scenarios, try-on poses (RON) and external
+//! bodies (OBJ, PLY) — and report each problem with file:line:column and field.
 //!
 //! A RON file's kind is found by trying each format: the first that reads it names it; when none
 //! does, the error reported is the one that got furthest into the file (the format the file most
@@ -29,6 +29,8 @@ pub enum Kind {
     Mesh,
     /// A scenario (the files it names must exist).
     Scenario,
+    /// A try-on pose (`atelier tryon --pose`, `fitted_pose.ron`).
+    TryonPose,
 }
 
 impl Kind {
@@ -43,6 +45,7 @@ impl Kind {
             Kind::RangeSide => "range side file",
             Kind::Mesh => "mesh",
             Kind::Scenario => "scenario",
+            Kind::TryonPose => "try-on pose",
         }
     }
 }
@@ -88,7 +91,7 @@ pub fn validate(path: &Path) -> Outcome {
             .map(|()| Kind::Scenario)
             .map_err(|e| (Some(Kind::Scenario), e));
     }
-    let attempts: [(Kind, &Check); 7] = [
+    let attempts: [(Kind, &Check); 8] = [
         (Kind::Fabric, &|p| {
             atelier_fabric::Fabric::load(p).map(|_| ())
         }),
@@ -110,6 +113,10 @@ pub fn validate(path: &Path) -> Outcome {
         }),
         (Kind::RangeSide, &|p| {
             atelier_fabric::files::load_ron::<atelier_grid::range::SideFile>(p).map(|_| ())
+        }),
+        (Kind::TryonPose, &|p| {
+            let pose: crate::tryon::pose::PoseFile = atelier_fabric::files::load_ron(p)?;
+            pose.check().map_err(|e| FileError::from_invalid(p, e))
         }),
         (Kind::Scenario, &|p| {
             let s = crate::scenario::Scenario::load(p)?;

@@ -245,7 +245,7 @@ proptest! {
     #[test]
     fn tryon_pictures(flips in prop::collection::vec((any::<usize>(), any::<u8>()), 1..8), cut in any::<usize>(), which in 0usize..2) {
         let name = ["fixtures/tryon/arms_raised_mask.png", "fixtures/tryon/mid_stride.png"][which];
-        let mut bytes = std::fs::read(loaders::root().join(name)).expect("fixture");
+        let mut bytes = std::fs::read(root().join(name)).expect("fixture");
         for (p, b) in flips {
             let i = p % bytes.len();
             bytes[i] = b;

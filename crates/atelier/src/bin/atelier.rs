@@ -101,7 +101,7 @@ enum Command {
         #[command(flatten)]
         options: Options,
     },
-    /// Check fabric, pattern, garment, body, motion, range side and scenario files (RON) and
+    /// Check fabric, pattern, garment, body, motion, range side, scenario and try-on pose files (RON) and
     /// body meshes (OBJ, PLY); print each problem with file:line:column and field.
     Validate {
         /// Files to check.

@@ -54,6 +54,20 @@ impl Camera {
     }
 }
 
+/// The most samples a full-resolution render takes (16 M): a large photograph is rendered with
+/// fewer samples per pixel rather than with gigabytes of buffer.
+pub const MAX_SAMPLES: usize = 1 << 24;
+
+/// Samples per pixel side for a `w × h` render: `wanted`, or fewer (at least 1) so that the
+/// render stays within [`MAX_SAMPLES`].
+pub fn samples_per_side((w, h): (usize, usize), wanted: usize) -> usize {
+    let mut ss = wanted.max(1);
+    while ss > 1 && w.saturating_mul(h).saturating_mul(ss * ss) > MAX_SAMPLES {
+        ss -= 1;
+    }
+    ss
+}
+
 /// The fraction of each pixel of a `w × h` picture the mesh covers, from `ss × ss` samples per
 /// pixel (row 0 at the top). Triangles facing away from the camera are skipped (a closed
 /// surface's front faces cover its silhouette); each front triangle is filled row by row
@@ -292,6 +306,10 @@ mod tests {
         assert_eq!((rw, rh), (8, 8));
         // 31 = 7·4 + 3: the last block averages 3 columns; the total of means × counts holds.
         assert!(r.iter().all(|v| v.is_finite()));
+        assert_eq!(samples_per_side((420, 460), 4), 4);
+        // 24 megapixels: one sample per pixel (4 would take 384 M samples).
+        assert_eq!(samples_per_side((4000, 6000), 4), 1);
+        assert_eq!(samples_per_side((2000, 2000), 4), 2);
         assert!((iou(&[1.0, 1.0, 0.0, 0.0], &[1.0, 0.0, 1.0, 0.0]) - 1.0 / 3.0).abs() < 1e-15);
     }
 }

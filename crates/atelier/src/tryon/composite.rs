@@ -29,8 +29,10 @@ pub fn composite(
     colour: [f64; 3],
     light: [f64; 3],
 ) -> Composite {
-    const SS: usize = 2;
     let (w, h) = (photo.width, photo.height);
+    // 2 × 2 samples per pixel, fewer for a photograph too large for them (each sample holds a
+    // depth and a triangle).
+    let ss = super::camera::samples_per_side((w, h), 2);
     let mut points: Vec<[f64; 3]> = cloth.0.iter().map(|&p| camera.view(p)).collect();
     let mut triangles: Vec<[u32; 3]> = cloth.1.to_vec();
     triangles.extend(cloth.1.iter().map(|t| [t[0], t[2], t[1]]));
@@ -38,7 +40,7 @@ pub fn composite(
     let base = points.len() as u32;
     points.extend(body.0.iter().map(|&p| camera.view(p)));
     triangles.extend(body.1.iter().map(|t| t.map(|k| k + base)));
-    let ids = rasterise(&points, &triangles, camera.fit(w, h, SS), w * SS, h * SS);
+    let ids = rasterise(&points, &triangles, camera.fit(w, h, ss), w * ss, h * ss);
     let l = camera.view_direction(light);
     let ln = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt().max(1e-300);
     let shade = |t: usize| -> [f64; 3] {
@@ -63,9 +65,9 @@ pub fn composite(
         for x in 0..w {
             let mut sum = [0.0; 3];
             let mut k = 0usize;
-            for sy in 0..SS {
-                for sx in 0..SS {
-                    if let Some(t) = ids[(y * SS + sy) * w * SS + x * SS + sx]
+            for sy in 0..ss {
+                for sx in 0..ss {
+                    if let Some(t) = ids[(y * ss + sy) * w * ss + x * ss + sx]
                         && (t as usize) < n_cloth
                     {
                         let c = shade(t as usize);
@@ -81,7 +83,7 @@ pub fn composite(
             }
             let p = y * w + x;
             footprint[p] = true;
-            let n = (SS * SS) as f64;
+            let n = (ss * ss) as f64;
             let cover = k as f64 / n;
             for i in 0..3 {
                 let photo_v = f64::from(photo.data[p * ch + i]) / 255.0;

@@ -314,7 +314,13 @@ pub fn tryon(
 
     let info = info(inputs, &mask, &fit, &fitted, motion_s, &picture);
     let setup = (clock.elapsed().as_secs_f64() - sim.wall_seconds).max(0.0);
-    let warnings = fit_warnings(&mask, &fit);
+    let mut warnings = fit_warnings(&mask, &fit);
+    if spec.motion.is_some() {
+        warnings.push(format!(
+            "{}: the garment scenario's own motion is not run; the try-on moves the body to the fitted pose",
+            inputs.garment.display()
+        ));
+    }
     let report = write_run(
         &scenario,
         Some(&inputs.garment),

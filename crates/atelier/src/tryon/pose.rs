@@ -32,7 +32,7 @@ use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::camera::{Camera, blur, coverage, iou, reduce};
+use super::camera::{Camera, blur, coverage, iou, reduce, samples_per_side};
 use super::image::Mask;
 
 /// The joint angles fitted: part, and the axes (0 x, 1 y, 2 z) of its joint.
@@ -343,7 +343,8 @@ pub fn fit_pose(mask: &Mask, options: &FitOptions) -> Result<PoseFit, String> {
     };
     let full = (mask.width, mask.height);
     let target_full = mask.coverage();
-    let before = coverage(&points, &triangles, &camera0, full, SUPERSAMPLE);
+    let full_ss = samples_per_side(full, SUPERSAMPLE);
+    let before = coverage(&points, &triangles, &camera0, full, full_ss);
     let iou_before = iou(&before, &target_full);
 
     let person_height = mask.bounds().map_or(1, |b| b[3] + 1 - b[1]) as f64;
@@ -421,7 +422,7 @@ pub fn fit_pose(mask: &Mask, options: &FitOptions) -> Result<PoseFit, String> {
     }
     let (camera, sizes, angles, _) = model.decode(&x, start, &start_angles);
     let (points, triangles) = posed_mannequin(&options.description, &sizes, &angles)?;
-    let silhouette = coverage(&points, &triangles, &camera, full, SUPERSAMPLE);
+    let silhouette = coverage(&points, &triangles, &camera, full, full_ss);
     let iou_after = iou(&silhouette, &target_full);
     Ok(PoseFit {
         angles,
