@@ -182,12 +182,12 @@ struct PartyProblem<'a> {
     profiles: &'a [TurnedProfile],
     angles: Vec<f64>,
     run: TurnedRun,
-    runs: std::cell::Cell<usize>,
+    runs: std::sync::atomic::AtomicUsize,
 }
 
 impl PartyProblem<'_> {
     fn residuals_at(&self, p: &DVector<f64>) -> Option<DVector<f64>> {
-        self.runs.set(self.runs.get() + 1);
+        self.runs.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let spindle = Spindle::new(p[0].exp(), p[1].exp()).ok()?;
         let mut fabric = self.base.clone();
         match self.direction {
@@ -257,7 +257,7 @@ pub fn fit_turned_party(
         profiles,
         angles,
         run: *run,
-        runs: std::cell::Cell::new(0),
+        runs: std::sync::atomic::AtomicUsize::new(0),
     };
     let start = DVector::from_vec(vec![start.0.ln(), start.1.ln()]);
     let r0 = problem.residuals_at(&start).ok_or_else(|| {
@@ -277,7 +277,7 @@ pub fn fit_turned_party(
         rigidity: p[0].exp(),
         residual_moment: p[1].exp(),
         rms: (cost / rows as f64).sqrt(),
-        runs: problem.runs.get(),
+        runs: problem.runs.load(std::sync::atomic::Ordering::Relaxed),
         termination,
     })
 }

@@ -96,14 +96,23 @@ fn find_key(text: &str, from: usize, name: &str) -> Option<usize> {
 
 /// Read a text file, an I/O failure as a [`FileError`] naming it.
 pub fn read_text(path: &Path) -> Result<String, FileError> {
-    std::fs::read_to_string(path).map_err(|e| FileError {
+    std::fs::read_to_string(path).map_err(|e| io_error(path, e))
+}
+
+/// Read a file's bytes, an I/O failure as a [`FileError`] naming it.
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>, FileError> {
+    std::fs::read(path).map_err(|e| io_error(path, e))
+}
+
+fn io_error(path: &Path, e: std::io::Error) -> FileError {
+    FileError {
         file: path.to_path_buf(),
         position: None,
         field: String::new(),
         kind: ErrorKind::Io,
         message: e.to_string(),
         source: Some(e),
-    })
+    }
 }
 
 /// Read and parse a RON file.

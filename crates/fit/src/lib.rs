@@ -10,6 +10,7 @@
 //! [`string::StringModel::equilibrium`] then reproduces any shape for given end positions.
 
 pub mod cloth;
+pub mod differenced;
 pub mod error;
 pub mod experiment;
 pub mod identify;

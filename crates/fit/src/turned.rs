@@ -18,8 +18,7 @@
 //! state committed after each equilibrium (Newton with backtracking on the stations' κ).
 
 use atelier_fabric::{BendingState, Spindle};
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use nalgebra::{DMatrix, DVector};
 
 use crate::FitError;
 use crate::cloth::{ProfilePoint, check_profile, fit_cantilever};
@@ -322,7 +321,7 @@ struct Problem<'a> {
     strip: TurnedStrip,
     profiles: &'a [TurnedProfile],
     angles: Vec<f64>,
-    evaluations: std::cell::Cell<usize>,
+    evaluations: std::sync::atomic::AtomicUsize,
 }
 
 impl Problem<'_> {
@@ -331,7 +330,8 @@ impl Problem<'_> {
     }
 
     fn residuals_at(&self, p: &DVector<f64>) -> Option<DVector<f64>> {
-        self.evaluations.set(self.evaluations.get() + 1);
+        self.evaluations
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let shapes = self
             .strip
             .shapes(p[0].exp(), p[1].exp(), &self.angles)
@@ -350,73 +350,7 @@ impl Problem<'_> {
     }
 }
 
-/// A least-squares problem given by its residual function; the Jacobian by central
-/// differences.
-struct Differenced<F> {
-    residuals: F,
-    p: DVector<f64>,
-    step: f64,
-}
-
-impl<F: Fn(&DVector<f64>) -> Option<DVector<f64>>> LeastSquaresProblem<f64, Dyn, Dyn>
-    for Differenced<F>
-{
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.p.copy_from(x);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.p.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        (self.residuals)(&self.p)
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        central_differences(&self.p, self.step, &self.residuals)
-    }
-}
-
-/// Levenberg–Marquardt (the `levenberg-marquardt` crate) from `start` on the problem whose
-/// residuals are `residuals`, its Jacobian by central differences of `step` in every parameter
-/// (a forward model whose shapes are only piecewise smooth in the parameters — reversals of a
-/// hysteretic path — needs a step that sees through the kinks): the parameters it ends at and
-/// how it ended.
-pub fn minimise(
-    start: DVector<f64>,
-    step: f64,
-    residuals: impl Fn(&DVector<f64>) -> Option<DVector<f64>>,
-) -> (DVector<f64>, String) {
-    let problem = Differenced {
-        residuals,
-        p: start,
-        step,
-    };
-    let (problem, report) = LevenbergMarquardt::new().minimize(problem);
-    (problem.p, format!("{:?}", report.termination))
-}
-
-/// The Jacobian of `residuals` at `p` by central differences with `step` in every parameter
-/// (None when a residual evaluation fails).
-fn central_differences(
-    p: &DVector<f64>,
-    step: f64,
-    residuals: &impl Fn(&DVector<f64>) -> Option<DVector<f64>>,
-) -> Option<DMatrix<f64>> {
-    let mut columns = Vec::with_capacity(p.len());
-    for c in 0..p.len() {
-        let (mut a, mut b) = (p.clone(), p.clone());
-        a[c] += step;
-        b[c] -= step;
-        columns.push((residuals(&a)? - residuals(&b)?) / (2.0 * step));
-    }
-    Some(DMatrix::from_columns(&columns))
-}
+pub use crate::differenced::minimise;
 
 /// Fit B and M₀ to profiles of one strip (overhang `length` m, weight per area `weight`
 /// N/m²) observed at increasing clamp angles, at least one of them turned (> 0°) — a
@@ -466,7 +400,7 @@ pub fn fit_turned(
         strip,
         profiles,
         angles,
-        evaluations: std::cell::Cell::new(0),
+        evaluations: std::sync::atomic::AtomicUsize::new(0),
     };
     let cost = |problem: &Problem, p: &DVector<f64>| {
         problem
@@ -520,7 +454,9 @@ pub fn fit_turned(
         residual_moment: p[1].exp(),
         rms: rms(fitted_cost),
         elastic_rms: rms(fc.min(fd)),
-        evaluations: problem.evaluations.get(),
+        evaluations: problem
+            .evaluations
+            .load(std::sync::atomic::Ordering::Relaxed),
         termination,
     })
 }

@@ -224,19 +224,9 @@ fn run_scenario(
     out: &Path,
     options: Options,
 ) -> ExitCode {
-    if let Some(n) = options.threads
-        && let Err(e) = rayon::ThreadPoolBuilder::new()
-            .num_threads(usize::from(n))
-            .build_global()
-    {
-        eprintln!("atelier: cannot start {n} threads: {e}");
-        return ExitCode::FAILURE;
-    }
-    let run_options = RunOptions {
-        frames: options
-            .frames
-            .map_or(FrameSelection::All, |k| FrameSelection::AtMost(k as usize)),
-        ..RunOptions::default()
+    let run_options = match start(options) {
+        Ok(o) => o,
+        Err(code) => return code,
     };
     let bar = progress_bar(&scenario.name);
     let mut progress = |f: f64| {
@@ -251,17 +241,7 @@ fn run_scenario(
     match result {
         Ok(report) => {
             let line = format!("{} (outputs in {})", report.summary_line(), out.display());
-            if report.passed() {
-                // The summary is the program's output.
-                #[allow(clippy::print_stdout)]
-                {
-                    println!("{line}");
-                }
-                ExitCode::SUCCESS
-            } else {
-                eprintln!("atelier: {line}");
-                ExitCode::from(2)
-            }
+            finish(&report, &line)
         }
         Err(e) => {
             eprintln!("atelier: {}: {e}", scenario.name);
@@ -287,19 +267,9 @@ fn parse_light(text: &str) -> Result<[f64; 3], String> {
 }
 
 fn tryon(inputs: &atelier::tryon::TryonInputs, out: &Path, options: Options) -> ExitCode {
-    if let Some(n) = options.threads
-        && let Err(e) = rayon::ThreadPoolBuilder::new()
-            .num_threads(usize::from(n))
-            .build_global()
-    {
-        eprintln!("atelier: cannot start {n} threads: {e}");
-        return ExitCode::FAILURE;
-    }
-    let run_options = RunOptions {
-        frames: options
-            .frames
-            .map_or(FrameSelection::All, |k| FrameSelection::AtMost(k as usize)),
-        ..RunOptions::default()
+    let run_options = match start(options) {
+        Ok(o) => o,
+        Err(code) => return code,
     };
     let bar = progress_bar("tryon");
     let mut progress = |f: f64| {
@@ -324,24 +294,51 @@ fn tryon(inputs: &atelier::tryon::TryonInputs, out: &Path, options: Options) -> 
                 report.summary_line(),
                 out.display()
             );
-            if report.passed() {
-                #[allow(clippy::print_stdout)]
-                {
-                    println!("{line}");
-                }
-                ExitCode::SUCCESS
-            } else {
-                eprintln!("atelier: {line}");
+            if !report.passed() {
                 for w in &report.warnings {
                     eprintln!("atelier: warning: {w}");
                 }
-                ExitCode::from(2)
             }
+            finish(&report, &line)
         }
         Err(e) => {
             eprintln!("atelier: tryon: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Start the thread pool (`--threads`) and the run's options (`--frames`); the exit code when
+/// the threads cannot start.
+fn start(options: Options) -> Result<RunOptions, ExitCode> {
+    if let Some(n) = options.threads
+        && let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(usize::from(n))
+            .build_global()
+    {
+        eprintln!("atelier: cannot start {n} threads: {e}");
+        return Err(ExitCode::FAILURE);
+    }
+    Ok(RunOptions {
+        frames: options
+            .frames
+            .map_or(FrameSelection::All, |k| FrameSelection::AtMost(k as usize)),
+        ..RunOptions::default()
+    })
+}
+
+/// The summary `line` on stdout and exit status 0 when the run passed; on stderr and 2 when not.
+fn finish(report: &atelier::report::Report, line: &str) -> ExitCode {
+    if report.passed() {
+        // The summary is the program's output.
+        #[allow(clippy::print_stdout)]
+        {
+            println!("{line}");
+        }
+        ExitCode::SUCCESS
+    } else {
+        eprintln!("atelier: {line}");
+        ExitCode::from(2)
     }
 }
 

@@ -87,14 +87,7 @@ fn error(
 /// expanded. 16-bit files are refused (the composite keeps the photograph's pixels bit for bit,
 /// which it could not do through an 8-bit reduction).
 fn decode(path: &Path) -> Result<(usize, usize, usize, Vec<u8>), FileError> {
-    let bytes = std::fs::read(path).map_err(|e| FileError {
-        file: path.to_path_buf(),
-        position: None,
-        field: String::new(),
-        kind: ErrorKind::Io,
-        message: e.to_string(),
-        source: Some(e),
-    })?;
+    let bytes = atelier_fabric::files::read_bytes(path)?;
     let png_err = |e: png::DecodingError| {
         error(
             path,

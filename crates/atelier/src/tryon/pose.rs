@@ -27,8 +27,8 @@ use std::time::Instant;
 use atelier_body::build::Sizes;
 use atelier_body::description::BodyDescription;
 use atelier_body::{Body, Mannequin, Part, Pose, PoseRate, Posed, V3};
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use atelier_fit::differenced::minimise_with;
+use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -411,14 +411,10 @@ pub fn fit_pose(mask: &Mask, options: &FitOptions) -> Result<PoseFit, String> {
             }
             Some(DVector::from_vec(r))
         };
-        let problem = Differenced {
-            residuals: &residuals,
-            p: x.clone(),
-            step: (f / finest as f64 * 0.5).max(0.5),
-        };
-        let (problem, report) = LevenbergMarquardt::new().with_patience(8).minimize(problem);
-        x = problem.p;
-        termination = format!("{:?}", report.termination);
+        let step = (f / finest as f64 * 0.5).max(0.5);
+        let (end, how) = minimise_with(x.clone(), step, 8, residuals);
+        x = end;
+        termination = how;
     }
     let (camera, sizes, angles, _) = model.decode(&x, start, &start_angles);
     let (points, triangles) = posed_mannequin(&options.description, &sizes, &angles)?;
@@ -581,47 +577,6 @@ fn search_limbs(
         }
     }
     Ok(best)
-}
-
-/// A least-squares problem whose Jacobian is taken by central differences, its columns in
-/// parallel.
-struct Differenced<'a, F: Fn(&DVector<f64>) -> Option<DVector<f64>> + Sync> {
-    residuals: &'a F,
-    p: DVector<f64>,
-    step: f64,
-}
-
-impl<F: Fn(&DVector<f64>) -> Option<DVector<f64>> + Sync> LeastSquaresProblem<f64, Dyn, Dyn>
-    for Differenced<'_, F>
-{
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.p.copy_from(x);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.p.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        (self.residuals)(&self.p)
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let columns: Option<Vec<DVector<f64>>> = (0..self.p.len())
-            .into_par_iter()
-            .map(|c| {
-                let (mut a, mut b) = (self.p.clone(), self.p.clone());
-                a[c] += self.step;
-                b[c] -= self.step;
-                Some(((self.residuals)(&a)? - (self.residuals)(&b)?) / (2.0 * self.step))
-            })
-            .collect();
-        Some(DMatrix::from_columns(&columns?))
-    }
 }
 
 /// A synthetic photograph for tests and figures: the mannequin of `sizes` at `angles` seen by
