@@ -344,3 +344,30 @@ fn bad_inputs_are_refused_naming_the_file_and_the_reason() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_given_start_pose_is_where_the_fit_starts() {
+    // Started at the truth (as `--pose` gives it), the start already overlaps (the standard pose
+    // overlaps the arms-raised silhouette by 0.29) and the fit stays there.
+    let e = example("arms_raised");
+    let (_, mask) = photo_of(&e);
+    let start = PoseFile::from_angles(&e.angles, None, None);
+    let text = ron::ser::to_string(&start).expect("serialises");
+    let start: PoseFile =
+        atelier_fabric::files::parse_ron(&text, Path::new("start.ron")).expect("reads back");
+    let options = FitOptions {
+        description: jis_9ar_description(),
+        height_cm: e.sizes.height_cm,
+        yaw_deg: e.camera.yaw_deg,
+        start,
+    };
+    let fit = fit_pose(&mask, &options).expect("fit");
+    assert!(fit.iou_before >= 0.9, "IoU at the start {}", fit.iou_before);
+    assert!(fit.iou_after >= 0.95, "IoU {}", fit.iou_after);
+    for (part, axes) in FITTED {
+        for &a in axes {
+            let err = (fit.angles[part.index()][a] - e.angles[part.index()][a]).abs();
+            assert!(err <= 5.0, "{} axis {a}: {err:.2}°", part.name());
+        }
+    }
+}
