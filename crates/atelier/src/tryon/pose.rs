@@ -177,15 +177,16 @@ pub struct PoseFit {
     pub termination: String,
 }
 
-/// The model: description, base sizes, and the layout of the parameter vector.
+/// The model: description, base sizes and joint limits. Its parameter vector, in units of about
+/// a pixel's effect each: scale (percent of the start's), origin column and row (pixels), bust
+/// girth (cm), then the fitted angles (degrees, in the order of [`FITTED`]).
 struct Model<'a> {
     options: &'a FitOptions,
     base: Sizes,
     limits: [atelier_body::JointLimits; 17],
 }
 
-/// The parameters, in units of about a pixel's effect each: scale (percent of the start's),
-/// origin column and row (pixels), bust girth (cm), then the fitted angles (degrees).
+/// The start's camera scale, px/m: the unit of the scale parameter.
 #[derive(Clone, Copy, Debug)]
 struct Start {
     scale: f64,
@@ -297,8 +298,7 @@ fn camera_from_boxes(points: &[[f64; 3]], mask: &Mask, yaw_deg: f64) -> Option<C
             hi[k] = hi[k].max(q[k]);
         }
     }
-    let (tw, th) = ((x1 + 1 - x0) as f64, (y1 + 1 - y0) as f64);
-    let _ = tw;
+    let th = (y1 + 1 - y0) as f64;
     let scale = th / (hi[1] - lo[1]).max(1e-9);
     let centre = [0.5 * (x0 + x1 + 1) as f64, 0.5 * (y0 + y1 + 1) as f64];
     Some(Camera {
