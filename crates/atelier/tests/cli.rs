@@ -9,17 +9,23 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-fn atelier(args: &[&str]) -> (bool, String, String) {
+/// Run the program from the repository root: exit code, stdout, stderr.
+fn status(args: &[&str]) -> (Option<i32>, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_atelier"))
         .args(args)
         .current_dir(root())
         .output()
         .expect("runs");
     (
-        out.status.success(),
+        out.status.code(),
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+fn atelier(args: &[&str]) -> (bool, String, String) {
+    let (code, stdout, stderr) = status(args);
+    (code == Some(0), stdout, stderr)
 }
 
 #[test]
@@ -522,19 +528,6 @@ fn atelier_fit_prints_the_fitted_rigidity_and_refuses_a_bad_profile() {
 }
 
 // ---- atelier tryon -----------------------------------------------------------------------
-
-fn status(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_atelier"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("runs");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 #[test]
 fn tryon_runs_the_fixture_and_refuses_a_mask_of_another_picture() {
