@@ -590,7 +590,8 @@ fn tryon_runs_the_fixture_and_refuses_a_mask_of_another_picture() {
         std::fs::read(out.join("composite.png")).expect("composite"),
         before
     );
-    // A light of zeros is refused by the argument parser.
+    // A light of zeros is refused by the argument parser: exit 1, as for any run that cannot
+    // start (clap's own code would be 2, atelier's "ran but failed").
     let (code, _, stderr) = status(&[
         "tryon",
         "--photo",
@@ -602,7 +603,11 @@ fn tryon_runs_the_fixture_and_refuses_a_mask_of_another_picture() {
         "--out",
         &out_s,
     ]);
-    assert_eq!(code, Some(2), "{stderr}");
+    assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("not all zero"), "{stderr}");
+    // Help is not an error.
+    let (code, stdout, _) = status(&["tryon", "--help"]);
+    assert_eq!(code, Some(0));
+    assert!(stdout.contains("--yaw"), "{stdout}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -8,7 +8,7 @@
 //!   virtual try-on from one photograph.
 //!
 //! Exit status: 0 success; 1 the run could not start or its outputs could not be written (bad
-//! file, missing file, unwritable folder); 2 the run ended early (diverged) or an expectation
+//! command line, bad file, missing file, unwritable folder); 2 the run ended early (diverged) or an expectation
 //! was not met — its report and outputs are written all the same. Errors are one line on
 //! stderr, never a backtrace.
 
@@ -121,7 +121,19 @@ struct Options {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // A command line clap refuses exits with 1, as every run that cannot start does (clap's own
+    // code, 2, is atelier's "ran but failed"); help and version print and exit with 0.
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::FAILURE
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     match cli.command {
         None => {
             let base = PathBuf::from(DEFAULT_BASE);
