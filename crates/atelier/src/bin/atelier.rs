@@ -8,8 +8,8 @@
 //!   virtual try-on from one photograph.
 //!
 //! Exit status: 0 success; 1 the run could not start or its outputs could not be written (bad
-//! command line, bad file, missing file, unwritable folder); 2 the run ended early (diverged) or an expectation
-//! was not met — its report and outputs are written all the same. Errors are one line on
+//! command line, bad file, missing file, unwritable folder); 2 the run ended early (diverged)
+//! or an expectation was not met — its report and outputs are written all the same. Errors are one line on
 //! stderr, never a backtrace.
 
 use std::io::IsTerminal;
