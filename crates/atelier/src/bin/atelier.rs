@@ -9,8 +9,8 @@
 //!
 //! Exit status: 0 success; 1 the run could not start or its outputs could not be written (bad
 //! command line, bad file, missing file, unwritable folder); 2 the run ended early (diverged)
-//! or an expectation was not met — its report and outputs are written all the same. Errors are one line on
-//! stderr, never a backtrace.
+//! or an expectation was not met — its report and outputs are written all the same. Errors are
+//! one line on stderr, never a backtrace.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
