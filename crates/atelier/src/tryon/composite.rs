@@ -43,21 +43,25 @@ pub fn composite(
     let ids = rasterise(&points, &triangles, camera.fit(w, h, ss), w * ss, h * ss);
     let l = camera.view_direction(light);
     let ln = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt().max(1e-300);
-    let shade = |t: usize| -> [f64; 3] {
-        let [a, b, c] = triangles[t].map(|k| points[k as usize]);
-        let (u, v) = (
-            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-        );
-        let n = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
-        let lit = ((n[0] * l[0] + n[1] * l[1] + n[2] * l[2]) / (len * ln)).max(0.0);
-        colour.map(|c| c * (0.3 + 0.7 * lit))
-    };
+    // One shade per garment triangle (the samples look them up).
+    let shades: Vec<[f64; 3]> = triangles[..n_cloth]
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|k| points[k as usize]);
+            let (u, v) = (
+                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+            );
+            let n = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
+            let lit = ((n[0] * l[0] + n[1] * l[1] + n[2] * l[2]) / (len * ln)).max(0.0);
+            colour.map(|c| c * (0.3 + 0.7 * lit))
+        })
+        .collect();
     let mut data = photo.data.clone();
     let mut footprint = vec![false; w * h];
     let ch = photo.channels;
@@ -70,7 +74,7 @@ pub fn composite(
                     if let Some(t) = ids[(y * ss + sy) * w * ss + x * ss + sx]
                         && (t as usize) < n_cloth
                     {
-                        let c = shade(t as usize);
+                        let c = shades[t as usize];
                         for i in 0..3 {
                             sum[i] += c[i];
                         }

@@ -22,6 +22,7 @@
 //! limits), so their sign is never in doubt.
 
 use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use atelier_body::build::Sizes;
@@ -184,6 +185,7 @@ struct Model<'a> {
     options: &'a FitOptions,
     base: Sizes,
     limits: [atelier_body::JointLimits; 17],
+    bodies: Bodies<'a>,
 }
 
 /// The start's camera scale, px/m: the unit of the scale parameter.
@@ -267,18 +269,63 @@ pub fn posed_mannequin(
 ) -> Result<Mesh, String> {
     let mannequin = Mannequin::from_description(description, sizes).map_err(|e| e.to_string())?;
     let body = Body::new(mannequin);
+    Ok((posed(&body, angles), body.rest.triangles.clone()))
+}
+
+/// The vertices of `body` posed at `angles`.
+fn posed(body: &Body, angles: &[[f64; 3]; 17]) -> Vec<[f64; 3]> {
     let list: Vec<(Part, [f64; 3])> = Part::ALL.iter().map(|&p| (p, angles[p.index()])).collect();
     let rate = PoseRate {
         pose: Pose::from_angles(&list, V3::zeros()),
         omega: [V3::zeros(); 17],
         root_velocity: V3::zeros(),
     };
-    let mut posed = Posed::default();
-    body.pose_into(&rate, &mut posed);
-    Ok((
-        posed.positions.iter().map(|p| [p.x, p.y, p.z]).collect(),
-        body.rest.triangles.clone(),
-    ))
+    let mut out = Posed::default();
+    body.pose_into(&rate, &mut out);
+    out.positions.iter().map(|p| [p.x, p.y, p.z]).collect()
+}
+
+/// The mannequins the fit has built, by size: most evaluations change only angles, and building
+/// a mannequin (the description scaled, its girths corrected) costs more than posing it. The
+/// last few sizes are kept.
+struct Bodies<'a> {
+    description: &'a BodyDescription,
+    built: Mutex<Vec<(Sizes, Arc<Body>)>>,
+}
+
+impl Bodies<'_> {
+    /// Sizes kept.
+    const KEPT: usize = 8;
+
+    fn at(&self, sizes: &Sizes) -> Result<Arc<Body>, String> {
+        let lock = || {
+            self.built
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        };
+        if let Some((_, body)) = lock().iter().find(|(s, _)| s == sizes) {
+            return Ok(Arc::clone(body));
+        }
+        let mannequin =
+            Mannequin::from_description(self.description, sizes).map_err(|e| e.to_string())?;
+        let body = Arc::new(Body::new(mannequin));
+        let mut built = lock();
+        if built.len() >= Self::KEPT {
+            built.remove(0);
+        }
+        built.push((*sizes, Arc::clone(&body)));
+        Ok(body)
+    }
+
+    /// The vertices of the mannequin of `sizes` posed at `angles`, and the mannequin.
+    fn posed(
+        &self,
+        sizes: &Sizes,
+        angles: &[[f64; 3]; 17],
+    ) -> Result<(Vec<[f64; 3]>, Arc<Body>), String> {
+        let body = self.at(sizes)?;
+        Ok((posed(&body, angles), body))
+    }
 }
 
 /// The camera that puts the model's box on the mask's box (scale from the heights, origin from
@@ -321,19 +368,23 @@ pub fn fit_pose(mask: &Mask, options: &FitOptions) -> Result<PoseFit, String> {
         .map_err(|e| format!("the start pose: {e}"))?;
     let mut base = options.start.sizes.unwrap_or(options.description.sizes);
     base.height_cm = options.height_cm;
+    let bodies = Bodies {
+        description: &options.description,
+        built: Mutex::new(Vec::new()),
+    };
     let mut limits = [atelier_body::JointLimits::FIXED; 17];
-    let probe =
-        Mannequin::from_description(&options.description, &base).map_err(|e| e.to_string())?;
-    for p in &probe.parts {
+    for p in &bodies.at(&base)?.mannequin.parts {
         limits[p.part.index()] = p.limits;
     }
     let model = Model {
         options,
         base,
         limits,
+        bodies,
     };
     let start_angles = options.start.angles();
-    let (points, triangles) = posed_mannequin(&options.description, &base, &start_angles)?;
+    let (points, body) = model.bodies.posed(&base, &start_angles)?;
+    let triangles = &body.rest.triangles;
     let camera0 = match options.start.camera {
         Some(c) => Camera {
             yaw_deg: options.yaw_deg,
@@ -344,7 +395,7 @@ pub fn fit_pose(mask: &Mask, options: &FitOptions) -> Result<PoseFit, String> {
     let full = (mask.width, mask.height);
     let target_full = mask.coverage();
     let full_ss = samples_per_side(full, SUPERSAMPLE);
-    let before = coverage(&points, &triangles, &camera0, full, full_ss);
+    let before = coverage(&points, triangles, &camera0, full, full_ss);
     let iou_before = iou(&before, &target_full);
 
     let person_height = mask.bounds().map_or(1, |b| b[3] + 1 - b[1]) as f64;
@@ -355,7 +406,7 @@ pub fn fit_pose(mask: &Mask, options: &FitOptions) -> Result<PoseFit, String> {
     let camera1 = if options.start.camera.is_some() {
         camera0
     } else {
-        let (points, _) = posed_mannequin(&options.description, &base, &searched)?;
+        let (points, _) = model.bodies.posed(&base, &searched)?;
         camera_from_boxes(&points, mask, options.yaw_deg).ok_or("the mask is empty")?
     };
     let start = Start {
@@ -385,15 +436,20 @@ pub fn fit_pose(mask: &Mask, options: &FitOptions) -> Result<PoseFit, String> {
         let residuals = |x: &DVector<f64>| -> Option<DVector<f64>> {
             evaluations.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let (camera, sizes, angles, excess) = model.decode(x, start, &start_angles);
-            let (points, triangles) =
-                posed_mannequin(&options.description, &sizes, &angles).ok()?;
+            let (points, body) = model.bodies.posed(&sizes, &angles).ok()?;
             let level_camera = Camera {
                 scale: camera.scale / f,
                 origin_px: [camera.origin_px[0] / f, camera.origin_px[1] / f],
                 ..camera
             };
             let c = blur(
-                &coverage(&points, &triangles, &level_camera, (rw, rh), SUPERSAMPLE),
+                &coverage(
+                    &points,
+                    &body.rest.triangles,
+                    &level_camera,
+                    (rw, rh),
+                    SUPERSAMPLE,
+                ),
                 (rw, rh),
                 sigma,
             );
@@ -417,8 +473,8 @@ pub fn fit_pose(mask: &Mask, options: &FitOptions) -> Result<PoseFit, String> {
         termination = how;
     }
     let (camera, sizes, angles, _) = model.decode(&x, start, &start_angles);
-    let (points, triangles) = posed_mannequin(&options.description, &sizes, &angles)?;
-    let silhouette = coverage(&points, &triangles, &camera, full, full_ss);
+    let (points, body) = model.bodies.posed(&sizes, &angles)?;
+    let silhouette = coverage(&points, &body.rest.triangles, &camera, full, full_ss);
     let iou_after = iou(&silhouette, &target_full);
     Ok(PoseFit {
         angles,
@@ -472,9 +528,7 @@ fn search_limbs(
         .map_or(0, |b| (b[3] + 1 - b[1]) / (6 * factor)) as isize;
     let distance = |angles: &[[f64; 3]; 17]| -> f64 {
         evaluations.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let Ok((points, triangles)) =
-            posed_mannequin(&model.options.description, &model.base, angles)
-        else {
+        let Ok((points, body)) = model.bodies.posed(&model.base, angles) else {
             return f64::INFINITY;
         };
         let Some(camera) = camera_from_boxes(&points, mask, model.options.yaw_deg) else {
@@ -486,7 +540,7 @@ fn search_limbs(
             ..camera
         };
         let c = blur(
-            &coverage(&points, &triangles, &level, (rw, rh), 2),
+            &coverage(&points, &body.rest.triangles, &level, (rw, rh), 2),
             (rw, rh),
             1.0,
         );
