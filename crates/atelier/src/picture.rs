@@ -92,25 +92,27 @@ pub fn render_lit(
 ) -> Vec<Option<[f64; 3]>> {
     let view_points: Vec<[f64; 3]> = positions.iter().map(|&p| to_view(p, view)).collect();
     let ids = rasterise(&view_points, triangles, fit, w, h);
-    let light = light.map(|l| {
-        let n = dot(l, l).sqrt().max(1e-300);
-        l.map(|v| v / n)
-    });
-    let shades: Vec<f64> = triangles
+    // One colour per triangle, shaded (the pixels look them up).
+    let rgb: Vec<[f64; 3]> = triangles
         .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|k| view_points[k as usize]);
-            let n = cross(sub(b, a), sub(c, a));
-            let len = dot(n, n).sqrt().max(1e-300);
-            match light {
-                None => 0.25 + 0.75 * n[2] / len,
-                Some(l) => 0.3 + 0.7 * (dot(n, l) / len).max(0.0),
-            }
+        .enumerate()
+        .map(|(t, tri)| {
+            let shade = triangle_shade(tri.map(|k| view_points[k as usize]), light);
+            colour(t).map(|v| v * shade)
         })
         .collect();
-    ids.iter()
-        .map(|id| id.map(|t| colour(t as usize).map(|v| v * shades[t as usize])))
-        .collect()
+    ids.iter().map(|id| id.map(|t| rgb[t as usize])).collect()
+}
+
+/// The shade of a triangle (corners in a view's frame) as [`render_lit`] draws it: lit by
+/// `light` (any length; towards the light), or from the viewer without one.
+pub fn triangle_shade([a, b, c]: [[f64; 3]; 3], light: Option<[f64; 3]>) -> f64 {
+    let n = cross(sub(b, a), sub(c, a));
+    let len = dot(n, n).sqrt().max(1e-300);
+    match light {
+        None => 0.25 + 0.75 * n[2] / len,
+        Some(l) => 0.3 + 0.7 * (dot(n, l) / (len * dot(l, l).sqrt().max(1e-300))).max(0.0),
+    }
 }
 
 /// The front-most triangle at each pixel centre (`None`: nothing), `w × h`, row 0 at the top,

@@ -7,7 +7,7 @@
 
 use super::camera::Camera;
 use super::image::{Mask, Photo};
-use crate::picture::{MeshRef, rasterise};
+use crate::picture::{MeshRef, rasterise, triangle_shade};
 
 /// A composite and where the garment is.
 #[derive(Clone, Debug)]
@@ -41,25 +41,13 @@ pub fn composite(
     points.extend(body.0.iter().map(|&p| camera.view(p)));
     triangles.extend(body.1.iter().map(|t| t.map(|k| k + base)));
     let ids = rasterise(&points, &triangles, camera.fit(w, h, ss), w * ss, h * ss);
-    let l = camera.view_direction(light);
-    let ln = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt().max(1e-300);
     // One shade per garment triangle (the samples look them up).
+    let light = Some(camera.view_direction(light));
     let shades: Vec<[f64; 3]> = triangles[..n_cloth]
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|k| points[k as usize]);
-            let (u, v) = (
-                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-            );
-            let n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
-            let lit = ((n[0] * l[0] + n[1] * l[1] + n[2] * l[2]) / (len * ln)).max(0.0);
-            colour.map(|c| c * (0.3 + 0.7 * lit))
+            let shade = triangle_shade(t.map(|k| points[k as usize]), light);
+            colour.map(|c| c * shade)
         })
         .collect();
     let mut data = photo.data.clone();
