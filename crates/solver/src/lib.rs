@@ -13,6 +13,7 @@
 pub mod baselines;
 pub mod cloth;
 pub mod contact;
+pub mod dual;
 pub mod kes;
 pub mod leg;
 pub mod long_range;
@@ -20,6 +21,7 @@ pub mod metrics;
 pub mod params;
 pub mod scenes;
 pub mod shear;
+pub mod shear_angle;
 pub mod state;
 pub mod step;
 pub mod wet;
