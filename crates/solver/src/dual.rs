@@ -36,6 +36,12 @@ type V3 = Vector3<f64>;
 /// Below this many rows the loops run on one thread.
 const PAR_MIN: usize = 4096;
 
+/// Slots per row: a row touches at most this many nodes (a cell's four corners).
+pub const SLOTS: usize = 4;
+
+/// An unused slot.
+pub const NONE: u32 = u32::MAX;
+
 /// Why the system could not be built or factorized.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum DualError {
@@ -82,6 +88,15 @@ impl NodeWeight {
     }
 }
 
+/// The preconditioner of the conjugate gradients.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Preconditioner {
+    /// The last LDLᵀ factorization (made first when there is none).
+    Factor,
+    /// The matrix's diagonal (Jacobi); nothing is factorized.
+    Diagonal,
+}
+
 /// What one solve did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SolveStats {
@@ -94,12 +109,8 @@ pub struct SolveStats {
 /// The structure, factorization and scratch of one constraint-space system.
 pub struct DualSystem {
     nodes: usize,
-    /// Rows → slots (CSR): row r has slots `row_ptr[r]..row_ptr[r + 1]`.
-    row_ptr: Vec<u32>,
-    /// The node of each slot.
+    /// The node of each slot: row r has slots `SLOTS·r .. SLOTS·(r + 1)`, unused ones [`NONE`].
     slot_node: Vec<u32>,
-    /// The row of each slot.
-    slot_row: Vec<u32>,
     /// Nodes → slots (CSR).
     node_ptr: Vec<u32>,
     node_slot: Vec<u32>,
@@ -116,7 +127,8 @@ pub struct DualSystem {
     factor: Vec<f64>,
     factored: bool,
     mem: MemBuffer,
-    /// Gradient of each slot's row with respect to its node (set by the caller).
+    /// Gradient of each slot's row with respect to its node (set by the caller; unused slots
+    /// are ignored).
     pub grad: Vec<V3>,
     /// Each row's diagonal addition: compliance over Δt² plus regularisation; rows the caller
     /// switches off get gradients 0 and 1 here (set by the caller).
@@ -124,6 +136,7 @@ pub struct DualSystem {
     /// Each node's weight (set by the caller).
     pub weight: Vec<NodeWeight>,
     // CG scratch.
+    d: Vec<f64>,
     u: Vec<V3>,
     r: Vec<f64>,
     z: Vec<f64>,
@@ -132,41 +145,35 @@ pub struct DualSystem {
 }
 
 impl DualSystem {
-    /// The system of `rows` (each the list of distinct nodes it touches) over `nodes` nodes:
-    /// pattern, assembly plan and symbolic factorization.
-    pub fn new(nodes: usize, rows: &[&[u32]]) -> Result<Self, DualError> {
+    /// The system of `rows` over `nodes` nodes: each row lists the distinct nodes it touches in
+    /// up to [`SLOTS`] slots, unused slots [`NONE`]. Builds the pattern, the assembly plan and
+    /// the symbolic factorization.
+    pub fn new(nodes: usize, rows: &[[u32; SLOTS]]) -> Result<Self, DualError> {
         let m = rows.len();
-        let mut row_ptr = Vec::with_capacity(m + 1);
-        let mut slot_node = Vec::new();
-        row_ptr.push(0u32);
         for (r, list) in rows.iter().enumerate() {
-            for &k in *list {
-                if k as usize >= nodes {
+            for &k in list {
+                if k != NONE && k as usize >= nodes {
                     return Err(DualError::NoSuchNode {
                         row: r,
                         node: k as usize,
                         nodes,
                     });
                 }
-                slot_node.push(k);
             }
-            row_ptr.push(slot_node.len() as u32);
         }
+        let slot_node: Vec<u32> = rows.iter().flatten().copied().collect();
         let slots = slot_node.len();
-        let slot_row: Vec<u32> = (0..m)
-            .flat_map(|r| (row_ptr[r]..row_ptr[r + 1]).map(move |_| r as u32))
-            .collect();
         // Nodes → slots.
         let mut node_ptr = vec![0u32; nodes + 1];
-        for &k in &slot_node {
+        for &k in slot_node.iter().filter(|&&k| k != NONE) {
             node_ptr[k as usize + 1] += 1;
         }
         for i in 0..nodes {
             node_ptr[i + 1] += node_ptr[i];
         }
         let mut fill = node_ptr.clone();
-        let mut node_slot = vec![0u32; slots];
-        for (s, &k) in slot_node.iter().enumerate() {
+        let mut node_slot = vec![0u32; node_ptr[nodes] as usize];
+        for (s, &k) in slot_node.iter().enumerate().filter(|(_, k)| **k != NONE) {
             node_slot[fill[k as usize] as usize] = s as u32;
             fill[k as usize] += 1;
         }
@@ -176,9 +183,9 @@ impl DualSystem {
             let list = &node_slot[node_ptr[i] as usize..node_ptr[i + 1] as usize];
             for &sa in list {
                 for &sb in list {
-                    let (ra, rb) = (slot_row[sa as usize], slot_row[sb as usize]);
+                    let (ra, rb) = (sa as usize / SLOTS, sb as usize / SLOTS);
                     if ra >= rb {
-                        by_col[rb as usize].push((ra, [sa, sb]));
+                        by_col[rb].push((ra as u32, [sa, sb]));
                     }
                 }
             }
@@ -191,7 +198,7 @@ impl DualSystem {
         col_ptr.push(0usize);
         for (c, mut entries) in by_col.into_iter().enumerate() {
             // The diagonal is always present (a row with no node keeps its `extra`).
-            entries.push((c as u32, [u32::MAX; 2]));
+            entries.push((c as u32, [NONE; 2]));
             entries.sort_unstable_by_key(|e| e.0);
             let mut k = 0;
             while k < entries.len() {
@@ -201,7 +208,7 @@ impl DualSystem {
                 }
                 row_idx.push(row as usize);
                 while k < entries.len() && entries[k].0 == row {
-                    if entries[k].1[0] != u32::MAX {
+                    if entries[k].1[0] != NONE {
                         plan.push(entries[k].1);
                     }
                     k += 1;
@@ -229,9 +236,7 @@ impl DualSystem {
         let factor = vec![0.0; symbolic.len_val()];
         Ok(Self {
             nodes,
-            row_ptr,
             slot_node,
-            slot_row,
             node_ptr,
             node_slot,
             pattern,
@@ -246,6 +251,7 @@ impl DualSystem {
             grad: vec![V3::zeros(); slots],
             extra: vec![0.0; m],
             weight: vec![NodeWeight::default(); nodes],
+            d: vec![0.0; m],
             u: vec![V3::zeros(); nodes],
             r: vec![0.0; m],
             z: vec![0.0; m],
@@ -264,16 +270,10 @@ impl DualSystem {
         self.nodes
     }
 
-    /// The slots of row `r` (indices into [`Self::grad`]).
+    /// The node of slot `s` ([`NONE`] for an unused slot).
     #[inline]
-    pub fn slots(&self, r: usize) -> std::ops::Range<usize> {
-        self.row_ptr[r] as usize..self.row_ptr[r + 1] as usize
-    }
-
-    /// The node of slot `s`.
-    #[inline]
-    pub fn slot_node(&self, s: usize) -> usize {
-        self.slot_node[s] as usize
+    pub fn slot_node(&self, s: usize) -> u32 {
+        self.slot_node[s]
     }
 
     /// Non-zeros of the lower triangle of the matrix, and of its factor.
@@ -374,7 +374,6 @@ impl DualSystem {
         Self::w_jt(
             &self.node_ptr,
             &self.node_slot,
-            &self.slot_row,
             &self.grad,
             &self.weight,
             x,
@@ -386,13 +385,12 @@ impl DualSystem {
     fn w_jt(
         node_ptr: &[u32],
         node_slot: &[u32],
-        slot_row: &[u32],
         grad: &[V3],
         weight: &[NodeWeight],
         x: &[f64],
         out: &mut [V3],
     ) {
-        let row_of = |s: u32| -> usize { slot_row[s as usize] as usize };
+        let row_of = |s: u32| -> usize { s as usize / SLOTS };
         let body = |(i, u): (usize, &mut V3)| {
             let mut sum = V3::zeros();
             for &s in &node_slot[node_ptr[i] as usize..node_ptr[i + 1] as usize] {
@@ -412,23 +410,18 @@ impl DualSystem {
         Self::w_jt(
             &self.node_ptr,
             &self.node_slot,
-            &self.slot_row,
             &self.grad,
             &self.weight,
             x,
             &mut self.u,
         );
-        let (row_ptr, grad, slot_node, u, extra) = (
-            &self.row_ptr,
-            &self.grad,
-            &self.slot_node,
-            &self.u,
-            &self.extra,
-        );
+        let (grad, slot_node, u, extra) = (&self.grad, &self.slot_node, &self.u, &self.extra);
         let body = |(r, yr): (usize, &mut f64)| {
             let mut s = extra[r] * x[r];
-            for k in row_ptr[r] as usize..row_ptr[r + 1] as usize {
-                s += grad[k].dot(&u[slot_node[k] as usize]);
+            for k in SLOTS * r..SLOTS * (r + 1) {
+                if slot_node[k] != NONE {
+                    s += grad[k].dot(&u[slot_node[k] as usize]);
+                }
             }
             *yr = s;
         };
@@ -439,8 +432,29 @@ impl DualSystem {
         }
     }
 
-    /// z = (the last factorization)⁻¹ r.
-    fn precondition(&mut self, r: &[f64], z: &mut [f64]) {
+    /// The matrix's diagonal, Σ_slots g·W g + extra, into `out`.
+    pub fn diagonal(&self, out: &mut [f64]) {
+        let (grad, slot_node, weight, extra) =
+            (&self.grad, &self.slot_node, &self.weight, &self.extra);
+        for (r, d) in out.iter_mut().enumerate() {
+            let mut v = extra[r];
+            for k in SLOTS * r..SLOTS * (r + 1) {
+                if slot_node[k] != NONE {
+                    v += grad[k].dot(&weight[slot_node[k] as usize].apply(&grad[k]));
+                }
+            }
+            *d = v;
+        }
+    }
+
+    /// z = M⁻¹ r for the preconditioner (`diag`: the diagonal, for [`Preconditioner::Diagonal`]).
+    fn precondition(&mut self, r: &[f64], z: &mut [f64], diag: Option<&[f64]>) {
+        if let Some(d) = diag {
+            for ((zk, rk), dk) in z.iter_mut().zip(r).zip(d) {
+                *zk = if *dk > 0.0 { rk / dk } else { *rk };
+            }
+            return;
+        }
         z.copy_from_slice(r);
         let ldlt = LdltRef::new(&self.symbolic, &self.factor);
         let n = z.len();
@@ -453,20 +467,31 @@ impl DualSystem {
         );
     }
 
-    /// Solve (J W Jᵀ + diag(extra)) x = b by conjugate gradients preconditioned with the last
-    /// factorization (factorizing first when there is none), to `‖r‖ ≤ tol·‖b‖` or
-    /// `max_iterations`. `x` is overwritten (the iteration starts from 0).
+    /// Solve (J W Jᵀ + diag(extra)) x = b by conjugate gradients with `pre`conditioning (the
+    /// last factorization, made first when there is none; or the diagonal), to
+    /// `‖r‖ ≤ tol·‖b‖` or `max_iterations`. `x` is overwritten (the iteration starts from 0).
     pub fn solve(
         &mut self,
         b: &[f64],
         x: &mut [f64],
         tol: f64,
         max_iterations: usize,
+        pre: Preconditioner,
         par: Par,
     ) -> Result<SolveStats, DualError> {
-        if !self.factored {
-            self.factorize(par)?;
-        }
+        let mut d = std::mem::take(&mut self.d);
+        let diag = match pre {
+            Preconditioner::Factor => {
+                if !self.factored {
+                    self.factorize(par)?;
+                }
+                None
+            }
+            Preconditioner::Diagonal => {
+                self.diagonal(&mut d);
+                Some(&d[..])
+            }
+        };
         let dot = |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).map(|(x, y)| x * y).sum() };
         x.iter_mut().for_each(|v| *v = 0.0);
         let b_norm = dot(b, b).sqrt();
@@ -478,7 +503,7 @@ impl DualSystem {
         let mut p = std::mem::take(&mut self.p);
         let mut q = std::mem::take(&mut self.q);
         r.copy_from_slice(b);
-        self.precondition(&r, &mut z);
+        self.precondition(&r, &mut z, diag);
         p.copy_from_slice(&z);
         let mut rz = dot(&r, &z);
         let mut stats = SolveStats {
@@ -501,7 +526,7 @@ impl DualSystem {
             if stats.relative_residual <= tol {
                 break;
             }
-            self.precondition(&r, &mut z);
+            self.precondition(&r, &mut z, diag);
             let rz_new = dot(&r, &z);
             let beta = rz_new / rz;
             rz = rz_new;
@@ -513,6 +538,7 @@ impl DualSystem {
         self.z = z;
         self.p = p;
         self.q = q;
+        self.d = d;
         Ok(stats)
     }
 }
@@ -525,16 +551,22 @@ mod tests {
     /// three-node row, one node on a plane.
     #[test]
     fn the_solve_matches_a_dense_solve() {
-        let rows: [&[u32]; 3] = [&[0, 1], &[1, 2], &[0, 1, 2]];
+        let rows = [[0, 1, NONE, NONE], [1, 2, NONE, NONE], [0, 1, 2, NONE]];
         let mut sys = DualSystem::new(3, &rows).expect("system");
+        let z = V3::zeros();
         let g = [
             V3::new(1.0, 0.2, -0.1),
             V3::new(-1.0, 0.1, 0.3),
+            z,
+            z,
             V3::new(0.0, 1.0, 0.5),
             V3::new(0.2, -1.0, 0.0),
+            z,
+            z,
             V3::new(0.3, 0.3, 0.3),
             V3::new(-0.5, 0.1, 0.9),
             V3::new(0.1, 0.7, -0.2),
+            z,
         ];
         sys.grad.copy_from_slice(&g);
         sys.weight = vec![
@@ -552,43 +584,65 @@ mod tests {
             },
         ];
         sys.extra = vec![0.1, 0.0, 0.3];
-        // Dense A.
-        let mut a = [[0.0; 3]; 3];
-        for r in 0..3 {
-            for s in 0..3 {
-                let mut v = if r == s { sys.extra[r] } else { 0.0 };
-                for kr in sys.slots(r) {
-                    for ks in sys.slots(s) {
-                        if sys.slot_node(kr) == sys.slot_node(ks) {
-                            v += g[kr].dot(&sys.weight[sys.slot_node(kr)].apply(&g[ks]));
+        let dense = |sys: &DualSystem| {
+            let mut a = [[0.0; 3]; 3];
+            for r in 0..3 {
+                for s in 0..3 {
+                    let mut v = if r == s { sys.extra[r] } else { 0.0 };
+                    for kr in SLOTS * r..SLOTS * (r + 1) {
+                        for ks in SLOTS * s..SLOTS * (s + 1) {
+                            let node = sys.slot_node(kr);
+                            if node != NONE && node == sys.slot_node(ks) {
+                                v += g[kr].dot(&sys.weight[node as usize].apply(&g[ks]));
+                            }
                         }
                     }
+                    a[r][s] = v;
                 }
-                a[r][s] = v;
             }
-        }
+            a
+        };
         let b = [1.0, -2.0, 0.5];
+        let check = |a: &[[f64; 3]; 3], x: &[f64; 3]| {
+            for r in 0..3 {
+                let ax: f64 = (0..3).map(|s| a[r][s] * x[s]).sum();
+                assert!((ax - b[r]).abs() < 1e-11, "row {r}: {ax} vs {}", b[r]);
+            }
+        };
         let mut x = [0.0; 3];
-        let stats = sys.solve(&b, &mut x, 1e-14, 10, Par::Seq).expect("solve");
+        let stats = sys
+            .solve(&b, &mut x, 1e-14, 10, Preconditioner::Factor, Par::Seq)
+            .expect("solve");
         assert!(stats.iterations <= 2, "{stats:?}");
-        for r in 0..3 {
-            let ax: f64 = (0..3).map(|s| a[r][s] * x[s]).sum();
-            assert!((ax - b[r]).abs() < 1e-12, "row {r}: {ax} vs {}", b[r]);
-        }
-        // A stale factorization still converges, in more iterations.
+        check(&dense(&sys), &x);
+        // A stale factorization is a preconditioner: it still converges, in more iterations.
         sys.weight[2].w = 0.8;
         let mut y = [0.0; 3];
-        let stats = sys.solve(&b, &mut y, 1e-12, 20, Par::Seq).expect("solve");
-        assert!(stats.relative_residual <= 1e-12 && stats.iterations >= 1);
+        let stats = sys
+            .solve(&b, &mut y, 1e-13, 20, Preconditioner::Factor, Par::Seq)
+            .expect("solve");
+        assert!(stats.relative_residual <= 1e-13, "{stats:?}");
+        check(&dense(&sys), &y);
+        // The diagonal preconditioner converges too, with more iterations.
+        let mut w = [0.0; 3];
+        let stats = sys
+            .solve(&b, &mut w, 1e-13, 50, Preconditioner::Diagonal, Par::Seq)
+            .expect("solve");
+        assert!(stats.relative_residual <= 1e-13, "{stats:?}");
+        check(&dense(&sys), &w);
+        // The correction W Jᵀ x of node 1 lies in its plane.
+        let dx = sys.correction(&y);
+        assert!(dx[1].z.abs() < 1e-15);
     }
 
     /// A row with no movable node (both nodes pinned) and no extra does not stop the
-    /// factorization: its pivot is regularised.
+    /// factorization: its pivot is regularised, and the other row is solved exactly.
     #[test]
     fn a_row_of_pinned_nodes_is_regularised() {
-        let rows: [&[u32]; 2] = [&[0, 1], &[1, 2]];
+        let rows = [[0, 1, NONE, NONE], [1, 2, NONE, NONE]];
         let mut sys = DualSystem::new(3, &rows).expect("system");
-        sys.grad = vec![V3::x(), -V3::x(), V3::x(), -V3::x()];
+        let z = V3::zeros();
+        sys.grad = vec![V3::x(), -V3::x(), z, z, V3::x(), -V3::x(), z, z];
         sys.weight = vec![
             NodeWeight::default(),
             NodeWeight::default(),
@@ -600,14 +654,21 @@ mod tests {
         sys.extra = vec![0.0, 0.0];
         sys.factorize(Par::Seq).expect("regularised");
         let mut x = [0.0; 2];
-        sys.solve(&[0.0, 1.0], &mut x, 1e-12, 5, Par::Seq)
-            .expect("solve");
+        sys.solve(
+            &[0.0, 1.0],
+            &mut x,
+            1e-12,
+            5,
+            Preconditioner::Factor,
+            Par::Seq,
+        )
+        .expect("solve");
         assert!((x[1] - 1.0).abs() < 1e-9, "{x:?}");
     }
 
     #[test]
     fn a_row_naming_a_missing_node_is_refused() {
-        let rows: [&[u32]; 1] = [&[0, 5]];
+        let rows = [[0, 5, NONE, NONE]];
         assert!(matches!(
             DualSystem::new(3, &rows),
             Err(DualError::NoSuchNode {
