@@ -260,6 +260,11 @@ impl DualSystem {
         })
     }
 
+    /// The gradients and extras to fill, beside the node weights (split borrows).
+    pub fn rows_mut(&mut self) -> (&mut [V3], &mut [f64], &[NodeWeight]) {
+        (&mut self.grad, &mut self.extra, &self.weight)
+    }
+
     /// Number of rows.
     pub fn rows(&self) -> usize {
         self.extra.len()

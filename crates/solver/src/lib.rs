@@ -20,6 +20,7 @@ pub mod long_range;
 pub mod metrics;
 pub mod params;
 pub mod scenes;
+pub mod shape;
 pub mod shear;
 pub mod shear_angle;
 pub mod state;

@@ -3,6 +3,8 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+use crate::shear_angle::ShearMeasure;
+
 /// How the internal axial forces p ≥ 0 are found (thesis (43)–(47)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum InternalMethod {
@@ -13,49 +15,51 @@ pub enum InternalMethod {
     Accelerated,
 }
 
-/// How the shape constraints (49)–(51) are iterated.
+/// How the shape constraints (49)–(51) are solved ([`crate::shape`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum ShapeMethod {
-    /// The thesis: `ṙ ← ṙ + γ R/Δt` (Jacobi gradient steps, each node's step divided by its
-    /// constraint count).
+    /// Newton (fast projection, Goldenthal et al. 2007) on the constraint-space system, each
+    /// linear solve by conjugate gradients preconditioned with a sparse LDLᵀ factorization
+    /// (faer; symbolic analysis reused while the rows are unchanged), renewed when a solve needs
+    /// more than `refactor_after` CG iterations. The default.
+    Direct {
+        /// CG iterations above which the factorization is renewed (0: every Newton step).
+        refactor_after: usize,
+    },
+    /// Newton with Jacobi-preconditioned conjugate gradients (nothing factorized).
+    ConjugateGradient {
+        /// CG iterations per Newton step (cap).
+        cg_iterations: usize,
+    },
+    /// The thesis: local corrections, each row by its own diagonal, scaled by the largest
+    /// constraint count of its nodes (`shape_step` the γ of (51)).
     Jacobi,
-    /// The same steps with Chebyshev semi-iterative acceleration (Wang 2015); `rho` estimates the
+    /// Jacobi with Chebyshev semi-iterative acceleration (Wang 2015); `rho` estimates the
     /// spectral radius of the plain iteration, in (0, 1).
     Chebyshev {
         /// Spectral radius estimate.
         rho: f64,
     },
-    /// Nonlinear Gauss–Seidel by edge colour: each edge's error is removed exactly (mass-
-    /// weighted), colour after colour, over-relaxed by `omega` in (0, 2); edges of one colour
-    /// share no node, so a colour runs in parallel.
+    /// Nonlinear Gauss–Seidel over colours of rows sharing no node, each row solved exactly,
+    /// over-relaxed by `omega` in (0, 2).
     GaussSeidel {
         /// Over-relaxation factor.
         omega: f64,
     },
-    /// Fast projection (Goldenthal et al. 2007): each iteration is a Newton step on all length
-    /// constraints at once, the mass-weighted least-change correction `J W Jᵀ λ = −C` solved by
-    /// Jacobi-preconditioned conjugate gradients; converges where local iterations crawl
-    /// (heavy cloth hanging from a few points).
-    Newton {
-        /// Conjugate-gradient iterations per Newton step (cap).
-        cg_iterations: usize,
-        /// Relative residual at which CG stops.
-        cg_tolerance: f64,
-    },
 }
 
-/// Whether an edge class resists compression.
+impl ShapeMethod {
+    /// The default: [`ShapeMethod::Direct`] renewing its factorization after 4 CG iterations.
+    pub const DEFAULT: Self = Self::Direct { refactor_after: 4 };
+}
+
+/// Whether the axial edges resist compression.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ConstraintKind {
     /// Length held at the target (a compressed edge is pushed back: the cloth buckles).
     Equality,
     /// Only stretching beyond the target is corrected (the cloth may shrink in plane).
     StretchOnly,
-    /// Diagonals only: an elastic spring of the fabric's shear stiffness (`Cloth::
-    /// diagonal_stiffness`) held by a compliant (XPBD) constraint instead of a rigid one, so a
-    /// cell shears under in-plane load as the fabric does (a rigid cell of four sides and two
-    /// diagonals cannot change shape at all). Needs the Jacobi or Chebyshev shape method.
-    Compliant,
 }
 
 /// The thresholds ε^c (internal forces) and ε^e (shape), fixed or scaled with the cloth's speed
@@ -76,7 +80,8 @@ pub enum TolerancePolicy {
     },
 }
 
-/// Parameters of one step.
+/// Parameters of one step. The table in `docs/solver.md` is generated from
+/// `StepParams::default()` (`cargo xtask knob-table`), so the docs cannot disagree with it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct StepParams {
@@ -93,68 +98,82 @@ pub struct StepParams {
     /// Internal-force step γ as a fraction of the largest stable step 1/λ_max(AᵀA). Range (0, 2);
     /// default 1.
     pub internal_step: f64,
-    /// ε^c: stop the internal-force iterations when the projected gradient of E falls below ε^c
-    /// times its value with all forces zero (the thesis stops on E's relative change, which
-    /// stalls when E cannot reach zero; see `docs/solver.md`). Range (0, 1); default 1e-4.
+    /// ε^c: the internal-force iterations stop when the projected gradient of E falls below
+    /// ε^c times its value with all forces zero (a relative residual). Range (0, 1); default
+    /// 1e-4.
     pub internal_tolerance: f64,
-    /// Iteration cap for the internal forces, per phase. Range ≥ 1; default 10 (the forces are
-    /// warm-started, so a moving cloth converges over steps).
+    /// Iteration cap of the internal forces (a step whose forces stop at the cap says so in its
+    /// report). Range ≥ 1; default 200 (warm-started, they usually need far fewer).
     pub internal_max_iterations: usize,
-    /// Shape-constraint method. Default `Chebyshev { rho: 0.99 }`.
+    /// Shape-constraint method. Default `Direct { refactor_after: 4 }`.
     pub shape_method: ShapeMethod,
-    /// Shape step γ: a node moves by γ times the mean correction of its constraints (Jacobi
-    /// averaging; γ > 1 over-relaxes). Range (0, 2); default 1.
+    /// Shape step γ of the Jacobi and Chebyshev methods: a row's correction times γ over the
+    /// largest constraint count of its nodes. Range (0, 1]; default 1.
     pub shape_step: f64,
-    /// ε^e: stop the shape iterations when the RMS of R (the per-node length error) is below it,
-    /// m. Range > 0; default 1e-6.
+    /// ε^e: the shape stage stops when the largest relative violation — |l − l̄|/l⁰ over the
+    /// edges, the compliant residual |C + α̃λ| (rad) over the cells, the excess of ties and the
+    /// depth behind contact planes over the node spacing — is at most this. Range (0, 0.1];
+    /// default 1e-4. A step that ends above it is reported as not converged.
     pub shape_tolerance: f64,
-    /// Iteration cap for the shape constraints per collision pass. Range ≥ 1; default 30 (the
-    /// thesis: about 30 per pass, two passes).
+    /// Iteration cap of the shape stage per collision pass. Range ≥ 1; default 100 (the
+    /// global methods need 2–10 where the cloth is not flat; a flat sheet starting to sag is
+    /// a singular start and needs more).
     pub shape_max_iterations: usize,
-    /// Collision passes per step; the shape iterations are split between them (the thesis: two
-    /// passes of ~30 iterations). Range ≥ 1; default 2.
+    /// Collision passes per step; the shape stage runs before each (the thesis: two passes).
+    /// Range ≥ 1; default 2.
     pub collision_passes: usize,
     /// Axial edges: equality or stretch-only. Default `Equality` (see `docs/solver.md`).
     pub axial_constraint: ConstraintKind,
-    /// Diagonal (bias) edges. Default `Equality`.
-    pub diagonal_constraint: ConstraintKind,
+    /// How a cell's shear angle is measured (`shear_angle`). Default `Midpoint` (the angle
+    /// between the cell's midpoint vectors, in the plane of its diagonals).
+    pub shear_measure: ShearMeasure,
+    /// Factor on the fabric's shear stiffness (the loop's stresses and slopes): 1 the fabric,
+    /// 0 no shear resistance at all (the lower bound of the drape studies). Range [0, 1e3];
+    /// default 1.
+    pub shear_scale: f64,
+    /// Reversal dead band of the shear loop, rad: an angle change back smaller than this does
+    /// not start a minor loop. Range [0, 0.1); default 1e-4 rad (0.006°).
+    pub shear_deadband: f64,
+    /// Reversal dead band of the tensile loops as a fraction of each loop's maximum force: a
+    /// force change back smaller than this does not start a minor loop (solver jitter would
+    /// ratchet them). Range [0, 0.1); default 1e-3 (0.5 gf/cm at the KES Fm).
+    pub tensile_deadband: f64,
     /// Tolerance policy. Default `Fixed`.
     pub tolerance_policy: TolerancePolicy,
-    /// Treat the bending stiffness of each node implicitly along its normal (a diagonal,
-    /// linearised implicit term). Lifts the explicit limit Δt < 2√(μ/k) on fine grids and stiff
-    /// fabrics; changes no equilibrium. Default true.
+    /// Treat the bending stiffness of each node implicitly along its normal (a linearised
+    /// implicit term solved by BiCGSTAB). Lifts the explicit limit Δt < 2√(μ/k) on fine grids and
+    /// stiff fabrics; changes no equilibrium. Default true.
     pub implicit_bending: bool,
+    /// Relative residual at which the implicit bending solve stops. Range (0, 1); default 1e-6.
+    pub bending_tolerance: f64,
+    /// Iteration cap of the implicit bending solve (a step that stops at it says so). Range ≥ 1;
+    /// default 200.
+    pub bending_max_iterations: usize,
     /// Linearise the implicit bending term with the regularised spindle's steepest slope,
-    /// `bending_stick_slope`·B, where the fabric has bending hysteresis (instead of B). Cures
-    /// the node-by-node chatter of hysteretic strips on fine grids (a 10-cell wool cantilever
-    /// at Δt = 0.25·h: 7 cm/s for ever without it, at rest within 2 s with it), but made the
-    /// walking dress diverge while settling (0.4 s, edge strain 1.2), so it is off by default
-    /// until that is understood (`docs/solver.md`). Default false.
+    /// `bending_stick_slope`·B, where the fabric has bending hysteresis (instead of B). Default
+    /// false (`docs/solver.md`).
     pub implicit_stick_slope: bool,
-    /// Regularisation of the bending hysteresis: the square-root curves after each turning point
-    /// are infinitely steep, and an explicit bending force then amplifies rounding noise
-    /// (measured: a flat sheet in free fall develops 3e-4 m/s of spurious velocity spread in
-    /// 0.25 s). Their tangent is capped at this multiple of B over a tiny band
-    /// (`Spindle::with_stick_slope`). Range > 1 (∞ = exact); default 4.
+    /// Regularisation of the bending hysteresis: the tangent of the spindle's square-root curves
+    /// is capped at this multiple of B over a tiny band (`Spindle::with_stick_slope`). Range > 1
+    /// (∞ = exact); default 4.
     pub bending_stick_slope: f64,
     /// Reversal dead band of the bending hysteresis, as a fraction of each characteristic's
-    /// M₀/B (`Spindle::with_deadband`): curvature jitter smaller than this does not start a
-    /// minor loop. Range [0, 1); default 0.05.
+    /// M₀/B (`Spindle::with_deadband`). Range [0, 1); default 0.05.
     pub bending_deadband: f64,
     /// Skip bending entirely (an inextensible chain or membrane). Default false.
     pub bending_off: bool,
-    /// Long-range attachments ([`crate::long_range`]): hold every free node within its rest
-    /// distance from the pins times (1 + the step's largest target strain) in the shape
-    /// iterations — a bound the converged constraints imply, which carries the corrections of
-    /// a cloth hanging from a few pins across it in one projection. Nothing runs for a cloth
-    /// without pins. Default false (see `docs/solver.md`).
+    /// Long-range attachments ([`crate::long_range`]) for the local shape methods: every free
+    /// node held within its rest distance from the pins times (1 + the step's largest target
+    /// strain). Nothing runs for a cloth without pins, nor with the global methods. Default
+    /// false.
     pub long_range_attachments: bool,
     /// Divergence guard: a step whose result stretches or shrinks any edge by more than this
     /// strain (|l/l⁰ − 1|) fails with `StepError::Diverged` and keeps the state. Range > 0;
     /// default 1 (a doubled edge: far beyond any fabric's EMT).
     pub divergence_strain: f64,
-    /// Track hysteresis (tensile minor loops, bending spindle) when the fabric has it. Default
-    /// true; false uses the loading branch and the elastic spindle centre line.
+    /// Track hysteresis (tensile minor loops, bending spindle, shear loop) when the fabric has
+    /// it. Default true; false uses the loading branch, the spindle's centre line and the shear
+    /// loop's centre line.
     pub hysteresis: bool,
 }
 
@@ -167,16 +186,21 @@ impl Default for StepParams {
             internal_method: InternalMethod::Accelerated,
             internal_step: 1.0,
             internal_tolerance: 1e-4,
-            internal_max_iterations: 10,
-            shape_method: ShapeMethod::Chebyshev { rho: 0.99 },
+            internal_max_iterations: 200,
+            shape_method: ShapeMethod::DEFAULT,
             shape_step: 1.0,
-            shape_tolerance: 1e-6,
-            shape_max_iterations: 30,
+            shape_tolerance: 1e-4,
+            shape_max_iterations: 100,
             collision_passes: 2,
             axial_constraint: ConstraintKind::Equality,
-            diagonal_constraint: ConstraintKind::Equality,
+            shear_measure: ShearMeasure::Midpoint,
+            shear_scale: 1.0,
+            shear_deadband: 1e-4,
+            tensile_deadband: 1e-3,
             tolerance_policy: TolerancePolicy::Fixed,
             implicit_bending: true,
+            bending_tolerance: 1e-6,
+            bending_max_iterations: 200,
             implicit_stick_slope: false,
             bending_stick_slope: 4.0,
             bending_deadband: 0.05,
@@ -259,39 +283,33 @@ impl StepParams {
         check(
             "shape_tolerance",
             self.shape_tolerance,
-            self.shape_tolerance > 0.0,
-            "> 0 m",
+            self.shape_tolerance > 0.0 && self.shape_tolerance <= 0.1,
+            "(0, 0.1]",
         )?;
-        check(
-            "shape_max_iterations",
-            self.shape_max_iterations as f64,
-            self.shape_max_iterations >= 1,
-            "≥ 1",
-        )?;
-        check(
-            "collision_passes",
-            self.collision_passes as f64,
-            self.collision_passes >= 1,
-            "≥ 1",
-        )?;
-        if self.axial_constraint == ConstraintKind::Compliant {
-            return Err(ParamError {
-                name: "axial_constraint",
-                value: 0.0,
-                range: "Equality or StretchOnly (Compliant is for diagonals)",
-            });
+        for (name, value) in [
+            ("shape_max_iterations", self.shape_max_iterations),
+            ("collision_passes", self.collision_passes),
+            ("bending_max_iterations", self.bending_max_iterations),
+        ] {
+            check(name, value as f64, value >= 1, "≥ 1")?;
         }
-        if self.diagonal_constraint == ConstraintKind::Compliant
-            && !matches!(
-                self.shape_method,
-                ShapeMethod::Jacobi | ShapeMethod::Chebyshev { .. }
-            )
-        {
-            return Err(ParamError {
-                name: "diagonal_constraint",
-                value: 0.0,
-                range: "Compliant needs the Jacobi or Chebyshev shape method",
-            });
+        check(
+            "bending_tolerance",
+            self.bending_tolerance,
+            self.bending_tolerance > 0.0 && self.bending_tolerance < 1.0,
+            "(0, 1)",
+        )?;
+        check(
+            "shear_scale",
+            self.shear_scale,
+            (0.0..=1e3).contains(&self.shear_scale),
+            "[0, 1000]",
+        )?;
+        for (name, value) in [
+            ("shear_deadband", self.shear_deadband),
+            ("tensile_deadband", self.tensile_deadband),
+        ] {
+            check(name, value, (0.0..0.1).contains(&value), "[0, 0.1)")?;
         }
         match self.shape_method {
             ShapeMethod::Chebyshev { rho } => {
@@ -303,24 +321,13 @@ impl StepParams {
                 omega > 0.0 && omega < 2.0,
                 "(0, 2)",
             )?,
-            ShapeMethod::Newton {
-                cg_iterations,
-                cg_tolerance,
-            } => {
-                check(
-                    "shape_method.cg_iterations",
-                    cg_iterations as f64,
-                    cg_iterations >= 1,
-                    "≥ 1",
-                )?;
-                check(
-                    "shape_method.cg_tolerance",
-                    cg_tolerance,
-                    cg_tolerance > 0.0 && cg_tolerance < 1.0,
-                    "(0, 1)",
-                )?;
-            }
-            ShapeMethod::Jacobi => {}
+            ShapeMethod::ConjugateGradient { cg_iterations } => check(
+                "shape_method.cg_iterations",
+                cg_iterations as f64,
+                cg_iterations >= 1,
+                "≥ 1",
+            )?,
+            ShapeMethod::Direct { .. } | ShapeMethod::Jacobi => {}
         }
         if let TolerancePolicy::Adaptive {
             loose_factor,
@@ -374,32 +381,6 @@ impl StepParams {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Compliant constraints: diagonals only, and only with the local shape methods.
-    #[test]
-    fn compliant_constraints_are_checked() {
-        let ok = StepParams {
-            diagonal_constraint: ConstraintKind::Compliant,
-            ..StepParams::default()
-        };
-        ok.validate().expect("compliant diagonals with Chebyshev");
-        let axial = StepParams {
-            axial_constraint: ConstraintKind::Compliant,
-            ..StepParams::default()
-        };
-        assert_eq!(
-            axial.validate().expect_err("axial").name,
-            "axial_constraint"
-        );
-        let newton = StepParams {
-            shape_method: ShapeMethod::GaussSeidel { omega: 1.0 },
-            ..ok
-        };
-        assert_eq!(
-            newton.validate().expect_err("GS").name,
-            "diagonal_constraint"
-        );
-    }
 
     #[test]
     fn defaults_are_valid_and_ranges_are_enforced() {
