@@ -101,6 +101,32 @@ pub(crate) fn branch<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(f64, f64)>,
     Ok(points)
 }
 
+/// A measured shear branch `(angle °, force gf/cm)`, each point checked as soon as it is read
+/// (so an error carries the position of the point itself), then the branch as a whole: see
+/// [`crate::shear::check_shear_point`] and [`crate::shear::check_shear_branch`].
+pub(crate) fn shear_branch<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(f64, f64)>, D::Error> {
+    struct Points;
+    impl<'de> serde::de::Visitor<'de> for Points {
+        type Value = Vec<(f64, f64)>;
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("a list of (angle °, force gf/cm) points")
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(
+            self,
+            mut seq: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut points: Vec<(f64, f64)> = Vec::new();
+            while let Some(p) = seq.next_element::<(f64, f64)>()? {
+                crate::shear::check_shear_point(&points, p).map_err(A::Error::custom)?;
+                points.push(p);
+            }
+            crate::shear::check_shear_extent(&points).map_err(A::Error::custom)?;
+            Ok(points)
+        }
+    }
+    d.deserialize_seq(Points)
+}
+
 /// Types whose fields must agree with each other; checked right after parsing.
 pub trait Validate {
     /// Check the fields against each other; the error names the field path below `self`.

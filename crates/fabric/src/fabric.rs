@@ -9,6 +9,7 @@ use crate::bending::Spindle;
 use crate::error::{ErrorKind, FileError, InvalidValue};
 use crate::files;
 use crate::plausibility::{self, FabricClass, PlausibilityWarning};
+use crate::shear::{ShearCurve, ShearLoop};
 use crate::spec::{BendingSpec, FabricSpec, Provenance, ShearSpec, TensileSpec};
 use crate::tensile::{Branch, TABLE_SEGMENTS, TensileLoop, TensileState};
 use crate::units;
@@ -39,16 +40,25 @@ pub struct Shear {
 }
 
 impl Shear {
-    /// From the file's KES values.
-    pub fn from_spec(s: &ShearSpec) -> Self {
-        Self {
-            stiffness: units::shear_stiffness_from_kes(s.g_gf_cm_deg),
-            hysteresis: units::force_from_kes(s.two_hg_gf_cm),
-            hysteresis_5deg: s.two_hg5_gf_cm.map(units::force_from_kes),
+    /// From the file's shear section: its KES values, or those fitted to its measured loop
+    /// ([`ShearSpec::kes_values`]). Errors when the section gives neither or both, or when its
+    /// loop is invalid.
+    pub fn from_spec(s: &ShearSpec) -> Result<Self, InvalidValue> {
+        s.to_loop()?;
+        let k = s.kes_values()?;
+        Ok(Self {
+            stiffness: units::shear_stiffness_from_kes(k.g_gf_cm_deg),
+            hysteresis: units::force_from_kes(k.two_hg_gf_cm),
+            hysteresis_5deg: k.two_hg5_gf_cm.map(units::force_from_kes),
             locking_angle: s
                 .locking_angle_deg
                 .map_or(DEFAULT_LOCKING_ANGLE, f64::to_radians),
-        }
+        })
+    }
+
+    /// The reconstructed KES-FB1 loop of these values ([`ShearLoop::from_kes`]).
+    pub fn to_loop(&self) -> Result<ShearLoop, InvalidValue> {
+        ShearLoop::from_kes(self.stiffness, self.hysteresis, self.hysteresis_5deg)
     }
 
     /// Shear angle (rad) on loading at shear force per width `tau` (N/m): the bilinear KES loop
@@ -164,7 +174,12 @@ impl Fabric {
         };
         let warp = tensile_of(&spec.tensile.warp, "tensile.warp")?;
         let weft = tensile_of(&spec.tensile.weft, "tensile.weft")?;
-        let shear = spec.shear.as_ref().map(Shear::from_spec);
+        let shear = spec
+            .shear
+            .as_ref()
+            .map(Shear::from_spec)
+            .transpose()
+            .map_err(|e| e.within("shear"))?;
         let bias45 = match (&spec.tensile.bias45, &shear) {
             (Some(t), _) => tensile_of(t, "tensile.bias45")?,
             (None, Some(s)) => bias_from_shear(&warp, &weft, s)?,
@@ -355,6 +370,19 @@ impl Fabric {
         )
         .ok_or_else(|| undefined("residual moment"))?;
         Spindle::new(b, m0).map_err(|e| e.within("bending"))
+    }
+
+    /// The in-plane shear characteristic with its hysteresis (KES-FB1), for the solver's shear
+    /// angle per cell. From the shear section when the file has one (its KES values, or those
+    /// fitted to its measured loop); otherwise derived from the warp, weft and 45° bias loading
+    /// branches by inverting the trellis relation of [`bias_from_shear`] ([`ShearCurve::to_loop`]:
+    /// G the mean slope between 0.5° and 5°, HG the stick, the width constant). Errors only when
+    /// the `shear` values were set by hand to something invalid (G ≤ 0, a falling branch).
+    pub fn shear_loop(&self) -> Result<ShearLoop, InvalidValue> {
+        match &self.shear {
+            Some(s) => s.to_loop().map_err(|e| e.within("shear")),
+            None => Ok(ShearCurve::from_fabric(self).to_loop()),
+        }
     }
 
     /// Values outside the typical bands of the fabric's class (see [`plausibility::check`]).

@@ -2,8 +2,9 @@
 //!
 //! The measured mechanics of a fabric as the PARTY cloth model uses them (Sakaguchi's thesis
 //! §3.6–3.7; `method.md` §0–§1): KES-F data converted to SI, the tensile characteristic with its
-//! hysteresis (minor loops), the bending characteristic with its hysteresis (spindle model),
-//! orthotropic interpolation to any material angle, and fabric files with provenance.
+//! hysteresis (minor loops), the bending characteristic with its hysteresis (spindle model), the
+//! in-plane shear characteristic with its hysteresis (the KES-FB1 loop), orthotropic
+//! interpolation to any material angle, and fabric files with provenance.
 //!
 //! ```
 //! use atelier_fabric::{Branch, TensileLoop, TensileState, TensileSummary, units};
@@ -20,7 +21,7 @@
 //! assert!(after < at_peak && after > major.strain(Branch::Loading, 50.0));
 //! ```
 //!
-//! Modules: [`units`] (KES ↔ SI), [`tensile`], [`bending`], [`anisotropy`], [`fabric`] (the SI
+//! Modules: [`units`] (KES ↔ SI), [`tensile`], [`bending`], [`shear`], [`anisotropy`], [`fabric`] (the SI
 //! fabric and the per-angle [`MaterialTable`]), [`spec`] (the file format), [`plausibility`],
 //! [`files`] (RON loading with positioned errors, atomic writes), [`error`].
 
@@ -33,6 +34,7 @@ pub mod files;
 pub(crate) mod interp;
 pub mod noise;
 pub mod plausibility;
+pub mod shear;
 pub mod spec;
 pub mod tensile;
 pub mod units;
@@ -47,5 +49,8 @@ pub use fabric::{
     bias_from_shear, trellis_strain,
 };
 pub use plausibility::{FabricClass, PlausibilityWarning};
+pub use shear::{
+    KesShearTest, ShearCurve, ShearFit, ShearLoop, ShearState, fit_shear, kes_shear_test,
+};
 pub use spec::FabricSpec;
 pub use tensile::{Branch, TABLE_SEGMENTS, TensileLoop, TensileState, TensileSummary};

@@ -7,7 +7,7 @@
 //!
 //! Units: mass per area mg/cm², thickness mm; tensile curves as `(force gf/cm, strain %)` pairs;
 //! KES tensile summary LT (–), EMT (%), RT (%), WT (gf·cm/cm²), Fm (gf/cm); shear G (gf/(cm·deg)),
-//! 2HG and 2HG5 (gf/cm); bending B (gf·cm²/cm), 2HB (gf·cm/cm); bending loops as
+//! 2HG and 2HG5 (gf/cm), shear loops as `(angle °, force gf/cm)` pairs; bending B (gf·cm²/cm), 2HB (gf·cm/cm); bending loops as
 //! `(curvature cm⁻¹, moment gf·cm/cm)` pairs.
 
 use serde::{Deserialize, Serialize};
@@ -41,7 +41,8 @@ pub struct FabricSpec {
     pub friction: f64,
     /// Tensile characteristic per direction.
     pub tensile: TensileSpecs,
-    /// KES shear values; required when no measured 45° tensile curves are given.
+    /// Shear: KES values or a measured loop; required when no measured 45° tensile curves are
+    /// given.
     #[serde(default)]
     pub shear: Option<ShearSpec>,
     /// Bending characteristic per direction.
@@ -254,23 +255,172 @@ impl Validate for MeasuredLoop {
     }
 }
 
-/// KES shear values.
+/// Shear data: the KES values (G, 2HG, optional 2HG5) or a measured loop (`measured`), one or
+/// the other; and the locking angle used when the bias tensile loop is derived from them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(remote = "Self", deny_unknown_fields)]
 pub struct ShearSpec {
-    /// Shear stiffness G, gf/(cm·deg).
-    #[serde(deserialize_with = "check::positive")]
-    pub g_gf_cm_deg: f64,
-    /// Hysteresis width at 0.5°, 2HG, gf/cm.
-    #[serde(deserialize_with = "check::non_negative")]
-    pub two_hg_gf_cm: f64,
-    /// Hysteresis width at 5°, 2HG5, gf/cm (kept for reports and plausibility).
-    #[serde(default, deserialize_with = "check::opt_non_negative")]
+    /// Shear stiffness G, gf/(cm·deg); required unless `measured` is given.
+    #[serde(
+        default,
+        deserialize_with = "check::opt_positive",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub g_gf_cm_deg: Option<f64>,
+    /// Hysteresis width at 0.5°, 2HG, gf/cm; required unless `measured` is given.
+    #[serde(
+        default,
+        deserialize_with = "check::opt_non_negative",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub two_hg_gf_cm: Option<f64>,
+    /// Hysteresis width at 5°, 2HG5, gf/cm (optional; the width stays 2HG without it).
+    #[serde(
+        default,
+        deserialize_with = "check::opt_non_negative",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub two_hg5_gf_cm: Option<f64>,
     /// Shear locking (jamming) angle, degrees, in (0, 90); default 40 (an assumption, see
     /// `docs/fabric.md`).
-    #[serde(default, deserialize_with = "check::opt_locking_angle")]
+    #[serde(
+        default,
+        deserialize_with = "check::opt_locking_angle",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub locking_angle_deg: Option<f64>,
+    /// A measured KES-FB1 loop, reduced to G, 2HG and 2HG5 as KES defines them (instead of the
+    /// three values).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured: Option<MeasuredShear>,
+}
+validated!(ShearSpec);
+
+/// The KES values of a shear section, in KES units: `(G gf/(cm·deg), 2HG gf/cm, 2HG5 gf/cm)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KesShearValues {
+    /// G, gf/(cm·deg).
+    pub g_gf_cm_deg: f64,
+    /// 2HG, gf/cm.
+    pub two_hg_gf_cm: f64,
+    /// 2HG5, gf/cm, when known.
+    pub two_hg5_gf_cm: Option<f64>,
+}
+
+impl ShearSpec {
+    /// A section of KES values (no measured loop, default locking angle).
+    pub fn kes(g_gf_cm_deg: f64, two_hg_gf_cm: f64, two_hg5_gf_cm: Option<f64>) -> Self {
+        Self {
+            g_gf_cm_deg: Some(g_gf_cm_deg),
+            two_hg_gf_cm: Some(two_hg_gf_cm),
+            two_hg5_gf_cm,
+            locking_angle_deg: None,
+            measured: None,
+        }
+    }
+
+    /// The KES values this section gives: as written, or fitted to the measured loop.
+    pub fn kes_values(&self) -> Result<KesShearValues, InvalidValue> {
+        match (&self.measured, self.g_gf_cm_deg, self.two_hg_gf_cm) {
+            (Some(m), None, None) if self.two_hg5_gf_cm.is_none() => {
+                let l = m.fit().map_err(|e| e.within("measured"))?.shear_loop;
+                let (lo, hi) = crate::shear::KES_SHEAR_ANGLES;
+                Ok(KesShearValues {
+                    g_gf_cm_deg: units::shear_stiffness_to_kes(l.stiffness()),
+                    two_hg_gf_cm: units::force_to_kes(2.0 * l.half_width(lo)),
+                    two_hg5_gf_cm: Some(units::force_to_kes(2.0 * l.half_width(hi))),
+                })
+            }
+            (Some(_), _, _) => Err(InvalidValue::new(
+                ErrorKind::Inconsistent,
+                "measured",
+                "give either the KES values (g_gf_cm_deg, two_hg_gf_cm, two_hg5_gf_cm) or a \
+                 measured loop, not both",
+            )),
+            (None, None, _) => Err(InvalidValue::new(
+                ErrorKind::MissingField,
+                "g_gf_cm_deg",
+                "missing field `g_gf_cm_deg` (or give a `measured` loop)",
+            )),
+            (None, _, None) => Err(InvalidValue::new(
+                ErrorKind::MissingField,
+                "two_hg_gf_cm",
+                "missing field `two_hg_gf_cm` (or give a `measured` loop)",
+            )),
+            (None, Some(g), Some(two_hg)) => Ok(KesShearValues {
+                g_gf_cm_deg: g,
+                two_hg_gf_cm: two_hg,
+                two_hg5_gf_cm: self.two_hg5_gf_cm,
+            }),
+        }
+    }
+
+    /// The reconstructed shear loop (SI).
+    pub fn to_loop(&self) -> Result<crate::ShearLoop, InvalidValue> {
+        let k = self.kes_values()?;
+        crate::ShearLoop::from_kes_units(k.g_gf_cm_deg, k.two_hg_gf_cm, k.two_hg5_gf_cm).map_err(
+            |e| InvalidValue {
+                field: match e.field.as_str() {
+                    "g" => "g_gf_cm_deg".into(),
+                    "two_hg" => "two_hg_gf_cm".into(),
+                    "two_hg5" => "two_hg5_gf_cm".into(),
+                    other => other.into(),
+                },
+                ..e
+            },
+        )
+    }
+}
+
+impl Validate for ShearSpec {
+    fn validate(&self) -> Result<(), InvalidValue> {
+        self.to_loop().map(|_| ())
+    }
+}
+
+/// A measured KES-FB1 shear loop in KES units: the two branches as `(angle °, force gf/cm)`
+/// points, each listed with the angle increasing. `upper` is the branch recorded while the angle
+/// rises (−γmax → +γmax), `lower` the one recorded while it falls (+γmax → −γmax), read back
+/// from −γmax. Each branch: at least 4 points covering −5°…+5°, angles strictly increasing and
+/// within ±30°, forces non-decreasing and within ±200 gf/cm; the lower branch never above the
+/// upper.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(remote = "Self", deny_unknown_fields)]
+pub struct MeasuredShear {
+    /// The branch recorded with the angle rising.
+    #[serde(deserialize_with = "check::shear_branch")]
+    pub upper: Vec<(f64, f64)>,
+    /// The branch recorded with the angle falling (listed with the angle increasing).
+    #[serde(deserialize_with = "check::shear_branch")]
+    pub lower: Vec<(f64, f64)>,
+}
+validated!(MeasuredShear);
+
+impl MeasuredShear {
+    /// The branches in SI: `(angle rad, force N/m)`.
+    pub fn si_branches(&self) -> (Points, Points) {
+        let conv = |v: &[(f64, f64)]| -> Vec<(f64, f64)> {
+            v.iter()
+                .map(|&(a, f)| (a.to_radians(), units::force_from_kes(f)))
+                .collect()
+        };
+        (conv(&self.upper), conv(&self.lower))
+    }
+
+    /// Reduce the loop to G, 2HG and 2HG5 (see [`crate::shear::fit_shear`]).
+    pub fn fit(&self) -> Result<crate::ShearFit, InvalidValue> {
+        crate::shear::check_shear_branch(&self.upper).map_err(|e| e.within("upper"))?;
+        crate::shear::check_shear_branch(&self.lower).map_err(|e| e.within("lower"))?;
+        crate::shear::check_shear_branches_apart(&self.upper, &self.lower)?;
+        let (up, down) = self.si_branches();
+        crate::shear::fit_checked(&up, &down)
+    }
+}
+
+impl Validate for MeasuredShear {
+    fn validate(&self) -> Result<(), InvalidValue> {
+        self.fit().map(|_| ())
+    }
 }
 
 /// Bending data in the four directions; warp and weft are required, the biases optional.

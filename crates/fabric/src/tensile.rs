@@ -140,6 +140,8 @@ pub struct TensileLoop {
     inv_f_max: f64,
     load: Box<[f64]>,
     unload: Box<[f64]>,
+    /// Force band (N/m) within which a force moving back does not count as a reversal.
+    deadband: f64,
 }
 
 impl TensileLoop {
@@ -212,6 +214,7 @@ impl TensileLoop {
             inv_f_max: 1.0 / f_max,
             load: load.into_boxed_slice(),
             unload: unload.into_boxed_slice(),
+            deadband: 0.0,
         })
     }
 
@@ -301,6 +304,23 @@ impl TensileLoop {
             out.unload[j] = unload0 + (unload_f0 - unload0) * f / f0;
         }
         out
+    }
+
+    /// The same loop with a reversal dead band: a force that turns back starts a minor loop only
+    /// once it has moved back by more than `band` (N/m) from its extreme; within the band the
+    /// strain runs back along the branch it was on. The minor loop then starts at the edge of the
+    /// band, on that branch, so the strain stays continuous. Without it the jitter of an iterative
+    /// solver's axial forces ratchets an edge through ever smaller minor loops. Default 0 (every
+    /// reversal counts, thesis (37)–(40) as printed); negative or NaN bands are treated as 0.
+    #[must_use]
+    pub fn with_deadband(mut self, band: f64) -> Self {
+        self.deadband = if band > 0.0 { band } else { 0.0 };
+        self
+    }
+
+    /// The reversal dead band, N/m.
+    pub fn deadband(&self) -> f64 {
+        self.deadband
     }
 
     /// The apex force (largest tabulated force), N/m.
@@ -527,7 +547,8 @@ impl TensileState {
         self.scale
     }
 
-    /// The last committed force, N/m.
+    /// The last committed force, N/m; with a dead band ([`TensileLoop::with_deadband`]) the
+    /// extreme of the current direction while the force has moved back less than the band.
     pub fn force(&self) -> f64 {
         self.force
     }
@@ -604,8 +625,21 @@ impl TensileState {
             }
             return (next, next.eval(l, f));
         }
-        // Reversal at the last force f_t (38)–(40).
-        let f_t = self.force;
+        let band = l.deadband;
+        if band > 0.0 && (f - self.force).abs() <= band {
+            // Inside the dead band: back along the current branch, the extreme kept.
+            return (*self, self.eval(l, f));
+        }
+        // Reversal at the last force f_t (38)–(40); with a dead band, at the band's edge.
+        let f_t = if band > 0.0 {
+            if self.unloading {
+                self.force + band
+            } else {
+                self.force - band
+            }
+        } else {
+            self.force
+        };
         let eps_t = self.eval(l, f_t);
         let mut next = Self {
             force: f,

@@ -329,3 +329,183 @@ fn the_documented_example_parses() {
         .expect("example parses");
     assert!(f.plausibility().is_empty(), "{:?}", f.plausibility());
 }
+
+/// The base file with a measured shear loop instead of the KES values (lines 14–17).
+fn with_measured_shear(upper: &str, lower: &str) -> String {
+    mutated(
+        "    shear: (g_gf_cm_deg: 1.2, two_hg_gf_cm: 2.0),\n",
+        &format!(
+            "    shear: (measured: (\n        upper: [{upper}],\n        lower: [{lower}],\n    )),\n"
+        ),
+    )
+}
+
+const UPPER: &str = "(-8.0, -11.4), (-5.0, -4.2), (-0.5, 0.4), (0.5, 1.6), (5.0, 7.8), (8.0, 11.4)";
+const LOWER: &str =
+    "(-8.0, -11.4), (-5.0, -7.8), (-0.5, -1.6), (0.5, -0.4), (5.0, 4.2), (8.0, 11.4)";
+
+/// A measured shear loop is reduced to G, 2HG, 2HG5 as KES defines them: G = mean slope over
+/// 0.5–5° = 1.2 gf/(cm·deg), 2HG = 2.0, 2HG5 = 3.6 gf/cm for these points.
+#[test]
+fn a_measured_shear_loop_parses_into_the_kes_values() {
+    let f = parse(&with_measured_shear(UPPER, LOWER)).expect("valid");
+    let s = f.shear.expect("shear");
+    assert_relative_eq!(
+        units::shear_stiffness_to_kes(s.stiffness),
+        1.2,
+        max_relative = 1e-12
+    );
+    assert_relative_eq!(units::force_to_kes(s.hysteresis), 2.0, max_relative = 1e-12);
+    assert_relative_eq!(
+        units::force_to_kes(s.hysteresis_5deg.expect("2HG5")),
+        3.6,
+        max_relative = 1e-12
+    );
+    let (got, want) = (
+        f.shear_loop().expect("loop"),
+        atelier_fabric::ShearLoop::from_kes_units(1.2, 2.0, Some(3.6)).expect("valid"),
+    );
+    for x in [0.0, 0.02, 0.06, 0.1] {
+        assert_relative_eq!(got.upper(x), want.upper(x), max_relative = 1e-12);
+        assert_relative_eq!(got.lower(x), want.lower(x), max_relative = 1e-12);
+    }
+    assert_relative_eq!(got.join_angle(), want.join_angle(), max_relative = 1e-12);
+}
+
+#[test]
+fn measured_shear_nan_is_rejected_at_its_point() {
+    expect_error(
+        &with_measured_shear(&UPPER.replace("(-0.5, 0.4)", "(-0.5, NaN)"), LOWER),
+        ErrorKind::NotFinite,
+        "shear.measured.upper[2]",
+        15,
+    );
+}
+
+#[test]
+fn measured_shear_in_wrong_units_is_rejected() {
+    // Angles beyond ±30° (KES measures to ±8°).
+    expect_error(
+        &with_measured_shear(&UPPER.replace("(8.0, 11.4)", "(45.0, 11.4)"), LOWER),
+        ErrorKind::OutOfRange,
+        "shear.measured.upper[5]",
+        15,
+    );
+    // Angles in radians: the branch does not reach ±5°.
+    let radians = "(-0.14, -11.4), (-0.087, -7.8), (-0.0087, -1.6), (0.0087, -0.4), (0.087, 4.2), (0.14, 11.4)";
+    let e = expect_error(
+        &with_measured_shear(UPPER, radians),
+        ErrorKind::OutOfRange,
+        "shear.measured.lower",
+        16,
+    );
+    assert!(e.message.contains("radians"), "{e}");
+    // A whole-specimen force in gf rather than gf/cm.
+    expect_error(
+        &with_measured_shear(UPPER, &LOWER.replace("(8.0, 11.4)", "(8.0, 228.0)")),
+        ErrorKind::OutOfRange,
+        "shear.measured.lower[5]",
+        16,
+    );
+}
+
+#[test]
+fn measured_shear_force_must_not_fall_along_a_branch() {
+    expect_error(
+        &with_measured_shear(UPPER, &LOWER.replace("(0.5, -0.4)", "(0.5, -2.0)")),
+        ErrorKind::NonMonotone,
+        "shear.measured.lower[3]",
+        16,
+    );
+}
+
+/// A branch whose angle turns back makes the loop cross itself.
+#[test]
+fn measured_shear_loop_crossing_itself_is_rejected() {
+    let e = expect_error(
+        &with_measured_shear(&UPPER.replace("(0.5, 1.6)", "(-1.0, 1.6)"), LOWER),
+        ErrorKind::NonMonotone,
+        "shear.measured.upper[3]",
+        15,
+    );
+    assert!(e.message.contains("cross itself"), "{e}");
+}
+
+/// Branches that cross: swapped (the lower above the upper everywhere inside) or crossing near
+/// +5° only (a figure of eight). The error names the first offending point.
+#[test]
+fn measured_shear_branches_that_cross_are_rejected() {
+    expect_error(
+        &with_measured_shear(LOWER, UPPER),
+        ErrorKind::Inconsistent,
+        "shear.measured.lower[1]",
+        17,
+    );
+    expect_error(
+        &with_measured_shear(UPPER, &LOWER.replace("(5.0, 4.2)", "(5.0, 8.5)")),
+        ErrorKind::Inconsistent,
+        "shear.measured.lower[4]",
+        17,
+    );
+}
+
+#[test]
+fn measured_shear_with_too_few_points_is_rejected() {
+    expect_error(
+        &with_measured_shear("(-8.0, -11.4), (0.5, 1.6), (8.0, 11.4)", LOWER),
+        ErrorKind::TooShort,
+        "shear.measured.upper",
+        15,
+    );
+}
+
+/// A shear section gives the KES values or a measured loop: both is inconsistent, neither is a
+/// missing G.
+#[test]
+fn shear_needs_kes_values_or_a_measured_loop_not_both() {
+    let both = with_measured_shear(UPPER, LOWER).replace(
+        "    shear: (measured: (",
+        "    shear: (g_gf_cm_deg: 1.2, two_hg_gf_cm: 2.0, measured: (",
+    );
+    expect_error(&both, ErrorKind::Inconsistent, "shear.measured", 17);
+    expect_error(
+        &mutated(
+            "shear: (g_gf_cm_deg: 1.2, two_hg_gf_cm: 2.0)",
+            "shear: (two_hg_gf_cm: 2.0)",
+        ),
+        ErrorKind::MissingField,
+        "shear.g_gf_cm_deg",
+        14,
+    );
+    // KES values whose lower branch would fall between 0.5° and 5°.
+    expect_error(
+        &mutated(
+            "two_hg_gf_cm: 2.0)",
+            "two_hg_gf_cm: 2.0, two_hg5_gf_cm: 15.0)",
+        ),
+        ErrorKind::Inconsistent,
+        "shear.two_hg5_gf_cm",
+        14,
+    );
+}
+
+/// A fabric description written back as RON (as `atelier fit` writes the fitted fabric, with
+/// implicit `Some`) parses to the same description: KES shear values and a measured loop alike.
+#[test]
+fn fabric_specs_round_trip_through_ron() {
+    use atelier_fabric::{FabricSpec, files};
+    for text in [
+        std::fs::read_to_string(root().join("fixtures/fabrics/cotton_broad.ron")).expect("fixture"),
+        with_measured_shear(UPPER, LOWER),
+    ] {
+        let spec: FabricSpec = files::parse_ron(&text, Path::new("in.ron")).expect("parses");
+        let pretty = ron::ser::PrettyConfig::new().depth_limit(4).extensions(
+            ron::extensions::Extensions::IMPLICIT_SOME
+                | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES,
+        );
+        let written = ron::ser::to_string_pretty(&spec, pretty).expect("serialises");
+        let back: FabricSpec =
+            files::parse_ron(&written, Path::new("out.ron")).expect("reads back");
+        assert_eq!(back, spec, "{written}");
+    }
+}

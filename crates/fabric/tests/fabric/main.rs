@@ -6,4 +6,5 @@ mod anisotropy;
 mod bending;
 mod common;
 mod files;
+mod shear;
 mod tensile;

@@ -320,3 +320,96 @@ proptest! {
         }
     }
 }
+
+/// The reversal dead band (`TensileLoop::with_deadband`): a rising force with backward jitter
+/// smaller than the band stays on the major loading branch (no minor loop, λ = 1), where the
+/// same jitter without a band starts minor loops; a move back beyond the band starts a minor
+/// loop at the band's edge, (40) through the point of the loading branch there, and the strain
+/// is continuous across the edge.
+#[test]
+fn tensile_deadband_ignores_jitter_smaller_than_the_band() {
+    let band = 2.0; // N/m
+    let plain = cotton_warp();
+    let l = cotton_warp().with_deadband(band);
+    assert!((l.deadband() - band).abs() < 1e-15 && plain.deadband() == 0.0);
+    let apex = l.apex_strain();
+    let (mut st, mut st_plain) = (TensileState::VIRGIN, TensileState::VIRGIN);
+    let mut plain_left_the_branch = false;
+    for k in 1..=100 {
+        let f = 3.0 * k as f64;
+        for x in [f, f - 1.5] {
+            let e = st.update(&l, x);
+            assert_relative_eq!(e, l.strain(Branch::Loading, x), max_relative = 1e-12);
+            assert_eq!(st.branch(), Branch::Loading);
+            assert_relative_eq!(st.scale(), 1.0);
+            let e_plain = st_plain.update(&plain, x);
+            plain_left_the_branch |=
+                (e_plain - plain.strain(Branch::Loading, x)).abs() > 1e-6 * apex;
+        }
+    }
+    assert!(plain_left_the_branch);
+    // Beyond the band: the minor loop starts at the edge, continuously.
+    let top = st.force();
+    assert_relative_eq!(top, 300.0);
+    let edge = top - band;
+    let (inside, outside) = (st.strain(&l, edge + 1e-9), st.strain(&l, edge - 1e-9));
+    assert!(
+        (inside - outside).abs() < 1e-9 * apex,
+        "{inside} against {outside}"
+    );
+    st.update(&l, top - 3.0);
+    assert_eq!(st.branch(), Branch::Unloading);
+    let (eps_t, eps_r) = (
+        l.strain(Branch::Loading, edge),
+        l.strain(Branch::Unloading, edge),
+    );
+    assert_relative_eq!(st.scale(), eps_t / eps_r, max_relative = 1e-12);
+    assert_relative_eq!(st.branch_strain(&l, edge), eps_t, max_relative = 1e-12);
+    // Negative and NaN bands are no band.
+    assert!(cotton_warp().with_deadband(-1.0).deadband() == 0.0);
+    assert!(cotton_warp().with_deadband(f64::NAN).deadband() == 0.0);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1000, ..ProptestConfig::default() })]
+
+    /// With any dead band, random force sequences keep the strain inside the major loop, every
+    /// reversal starts on the curve it leaves, and the peeked strain has no jump at the band's
+    /// edge.
+    #[test]
+    fn deadband_keeps_the_strain_inside_and_continuous(
+        lt in 0.5f64..0.9,
+        rt in 30.0f64..80.0,
+        band_fraction in 0.0f64..0.05,
+        forces in prop::collection::vec(0.0f64..1.0, 1..40),
+    ) {
+        let base = TensileLoop::from_summary(&summary(lt, 5.0, rt)).expect("loop");
+        let fm = base.max_force();
+        let band = band_fraction * fm;
+        let l = base.with_deadband(band);
+        let tol = 1e-12 * l.apex_strain();
+        let mut st = TensileState::VIRGIN;
+        for x in forces {
+            let f = x * fm;
+            let before = st;
+            let eps = st.update(&l, f);
+            if st.branch() != before.branch() {
+                // The reversal happened at the band's edge on the old curve.
+                let edge = if before.branch() == Branch::Loading {
+                    before.force() - band
+                } else {
+                    before.force() + band
+                };
+                prop_assert!((st.branch_strain(&l, edge) - before.branch_strain(&l, edge)).abs() <= 1e3 * tol);
+            }
+            let (lo, hi) = l.strains(f);
+            prop_assert!(eps >= lo - tol && eps <= hi + tol);
+            let edge = if st.branch() == Branch::Loading { st.force() - band } else { st.force() + band };
+            if edge > 1e-6 * fm && edge < fm {
+                let d = 1e-9 * fm;
+                let jump = (st.strain(&l, edge + d) - st.strain(&l, edge - d)).abs();
+                prop_assert!(jump <= 1e-6 * l.apex_strain(), "jump {} at the edge {}", jump, edge);
+            }
+        }
+    }
+}

@@ -1,0 +1,1118 @@
+//! The in-plane shear characteristic τ = ϕʰ(γ) and its hysteresis, as KES-FB1 measures it: the
+//! instrument imposes the shear angle γ and records the shear force per width τ, so the shear
+//! enters the cloth step as a resistance to deformation (`method.md` §2b), in the manner of the
+//! bending spindle ([`crate::bending`]).
+//!
+//! **Branches.** KES-FB1 cycles a 20 × 5 cm specimen to ±8° and reports G (the mean slope between
+//! 0.5° and 5°), 2HG (the loop width at 0.5°) and 2HG5 (at 5°). The loop is reconstructed as
+//! `upper(γ) = Gγ + h(|γ|)` (angle rising) and `lower(γ) = Gγ − h(|γ|)` (falling), with the half
+//! width `h = HG = 2HG/2` for `|γ| ≤ 0.5°`, growing linearly to `HG5 = 2HG5/2` at 5° and constant
+//! beyond (`h = HG` throughout when 2HG5 is not given). The loop is odd: `lower(−γ) = −upper(γ)`.
+//!
+//! **Curves between the branches (Masing's rule, with a finite slope).** Write a point between
+//! the branches by its normalised distance `q ∈ [0, 1]` from the branch it heads for (the *target*:
+//! `upper` while γ rises, `lower` while it falls): `τ = (1 − q)·target(γ) + q·opposite(γ)`. From a
+//! turning point at `(γ_t, q₀)` the curve is
+//!
+//! ```text
+//! q(s) = max(0, q₀ − φ(s/Δ_j)),   φ(u) = 2u − u² (u < 1), 1 (u ≥ 1),   s = |γ − γ_t|
+//! ```
+//!
+//! the same curve for every turning point, shifted to start there (assumption (II) of the bending
+//! model, Masing's rule). From a turning point on a branch (`q₀ = 1`) it reaches the opposite
+//! branch after exactly the **join angle** Δ_j with zero relative slope (τ and dτ/dγ continuous);
+//! from a turning point inside the loop (`q₀ < 1`) it reaches the target earlier, at
+//! `s = Δ_j (1 − √(1 − q₀))`, and follows it from there with a kink of `4h√(1 − q₀)/Δ_j` — as the
+//! spindle does (`method.md` §1.2). The initial curve from rest is the reversal curve scaled by ½
+//! (`q = ½(1 − 2|γ|/Δ_j)²`, reaching the branch at `|γ| = Δ_j/2`). Every curve starts with the
+//! finite slope `G + 2h(|γ_t|)·φ′(0)/Δ_j = G + 4h/Δ_j` — a cell is never rigid.
+//!
+//! **Join rule.** `Δ_j = min(2HG/G, 2.5°)`: the angle over which the elastic part Gγ grows by the
+//! loop width 2HG, the bending spindle's `2M₀/B` transferred to shear. The initial slope at rest is
+//! then `G + 4HG/Δ_j = 3G`. The cap keeps the KES cycle's reversals at ±8° rejoined by ±5.5°, before
+//! the measuring points 5°…0.5° (none of the fixtures reaches it: their Δ_j are 0.75°–1.67°).
+//!
+//! **Why truncate instead of joining smoothly from inside the loop.** A smooth join from every
+//! turning point needs a curve whose shape depends on q₀; either its span shrinks with q₀ (and
+//! its curvature grows) or its initial slope does, and both let a small cycle `a → b → a` return
+//! above where it started and *create* energy (`docs/fabric.md`, with the numbers). With one
+//! shape for all curves, a falling curve from b always lies below the rising curve that reached b,
+//! so every such cycle dissipates ≥ 0 (the proof is two lines on the concavity of φ; tested).
+//!
+//! **Dead band.** With [`ShearLoop::with_deadband`] a change of direction counts only once γ has
+//! moved back by more than the band from its extreme; inside the band γ runs back along the
+//! current curve (behind a turning point: parallel to the branches). The new curve then starts at
+//! the edge of the band, on the current curve, so τ stays continuous (the bending spindle starts
+//! it at the extreme instead and jumps by up to `√(8·band·M₀B)`).
+//!
+//! Units: γ in rad, τ in N/m, G in N/(m·rad).
+
+use crate::error::{ErrorKind, InvalidValue};
+use crate::fabric::Fabric;
+use crate::tensile::Branch;
+use crate::units;
+
+const DEG: f64 = std::f64::consts::PI / 180.0;
+
+/// The KES-FB1 measuring angles (rad): G is the mean slope between them, 2HG the width at the
+/// first, 2HG5 at the second.
+pub const KES_SHEAR_ANGLES: (f64, f64) = (0.5 * DEG, 5.0 * DEG);
+
+/// The KES-FB1 cycle's largest angle, ±8° (rad).
+pub const KES_MAX_SHEAR_ANGLE: f64 = 8.0 * DEG;
+
+/// Largest join angle Δ_j (rad): 2.5°, so that the KES cycle's reversal curves from ±8° have
+/// rejoined their branches by ±5.5°, before the measuring points.
+pub const MAX_JOIN_ANGLE: f64 = 2.5 * DEG;
+
+/// Largest |angle| a measured loop may contain, degrees (KES measures to ±8°; more is a unit
+/// slip or not a KES record).
+pub const MEASURED_MAX_ANGLE_DEG: f64 = 30.0;
+
+/// Largest |force| a measured loop may contain, gf/cm: the stiffest fabrics in the bands
+/// (denim, G ≤ 6 gf/(cm·deg)) stay below about 60 gf/cm at ±8°; more is a unit slip (a force
+/// for the whole 20 cm specimen in gf, for example).
+pub const MEASURED_MAX_FORCE_GF_CM: f64 = 200.0;
+
+/// Fewest points per measured branch.
+pub const MEASURED_MIN_POINTS: usize = 4;
+
+/// φ(u) = 2u − u² on [0, 1), 1 beyond: the normalised progress of a curve towards its branch.
+#[inline]
+fn progress(u: f64) -> f64 {
+    if u >= 1.0 { 1.0 } else { u * (2.0 - u) }
+}
+
+/// φ′(u) = 2(1 − u) on [0, 1), 0 beyond.
+#[inline]
+fn progress_slope(u: f64) -> f64 {
+    if u >= 1.0 { 0.0 } else { 2.0 * (1.0 - u) }
+}
+
+/// A reconstructed KES-FB1 shear loop (SI: γ in rad, τ in N/m).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShearLoop {
+    /// G, N/(m·rad).
+    stiffness: f64,
+    /// HG = 2HG/2, N/m.
+    hg: f64,
+    /// HG5 = 2HG5/2, N/m (= HG when 2HG5 is not given).
+    hg5: f64,
+    /// Δ_j, rad (0 for an elastic loop).
+    join: f64,
+    /// Reversal dead band, rad.
+    deadband: f64,
+}
+
+impl ShearLoop {
+    /// The loop of the KES values, given in SI: G in N/(m·rad), 2HG and 2HG5 in N/m (see
+    /// [`ShearLoop::from_kes_units`] for gf/(cm·deg) and gf/cm). G must be positive, the widths
+    /// finite and ≥ 0, and both branches must rise with γ: `G > |HG5 − HG|/4.5°` (otherwise the
+    /// lower branch would fall between 0.5° and 5°: an `Inconsistent` error).
+    pub fn from_kes(
+        g_n_per_m_rad: f64,
+        two_hg_n_per_m: f64,
+        two_hg5_n_per_m: Option<f64>,
+    ) -> Result<Self, InvalidValue> {
+        let g = g_n_per_m_rad;
+        let checks = [
+            ("g", Some(g)),
+            ("two_hg", Some(two_hg_n_per_m)),
+            ("two_hg5", two_hg5_n_per_m),
+        ];
+        for (name, v) in checks {
+            let Some(v) = v else { continue };
+            if !v.is_finite() {
+                return Err(InvalidValue::new(
+                    ErrorKind::NotFinite,
+                    name,
+                    format!("{v}"),
+                ));
+            }
+            if v < 0.0 {
+                return Err(InvalidValue::new(ErrorKind::Negative, name, format!("{v}")));
+            }
+        }
+        if g == 0.0 {
+            return Err(InvalidValue::new(
+                ErrorKind::OutOfRange,
+                "g",
+                "the shear stiffness G must be positive",
+            ));
+        }
+        let hg = 0.5 * two_hg_n_per_m;
+        let hg5 = two_hg5_n_per_m.map_or(hg, |w| 0.5 * w);
+        let growth = (hg5 - hg).abs() / (KES_SHEAR_ANGLES.1 - KES_SHEAR_ANGLES.0);
+        if growth >= g {
+            return Err(InvalidValue::new(
+                ErrorKind::Inconsistent,
+                "two_hg5",
+                format!(
+                    "2HG5 − 2HG = {:.4} gf/cm over 4.5° exceeds 2G·4.5° = {:.4} gf/cm: a branch \
+                     of the loop would fall between 0.5° and 5°",
+                    units::force_to_kes(2.0 * (hg5 - hg)),
+                    units::force_to_kes(2.0 * g * (KES_SHEAR_ANGLES.1 - KES_SHEAR_ANGLES.0))
+                ),
+            ));
+        }
+        let reference = if hg > 0.0 { hg } else { hg5 };
+        let join = if reference > 0.0 {
+            (2.0 * reference / g).min(MAX_JOIN_ANGLE)
+        } else {
+            0.0
+        };
+        Ok(Self {
+            stiffness: g,
+            hg,
+            hg5,
+            join,
+            deadband: 0.0,
+        })
+    }
+
+    /// The loop of KES values in KES units: G in gf/(cm·deg), 2HG and 2HG5 in gf/cm.
+    pub fn from_kes_units(
+        g_gf_cm_deg: f64,
+        two_hg_gf_cm: f64,
+        two_hg5_gf_cm: Option<f64>,
+    ) -> Result<Self, InvalidValue> {
+        Self::from_kes(
+            units::shear_stiffness_from_kes(g_gf_cm_deg),
+            units::force_from_kes(two_hg_gf_cm),
+            two_hg5_gf_cm.map(units::force_from_kes),
+        )
+    }
+
+    /// An elastic characteristic without hysteresis: τ = Gγ (G in N/(m·rad), > 0).
+    pub fn elastic(g_n_per_m_rad: f64) -> Result<Self, InvalidValue> {
+        Self::from_kes(g_n_per_m_rad, 0.0, None)
+    }
+
+    /// The loop of a measured force–angle record, reduced to G, 2HG and 2HG5 as KES defines them
+    /// (see [`fit_shear`]); `upper` and `lower` are `(angle rad, force N/m)` points of the two
+    /// branches, each listed with the angle increasing.
+    pub fn from_measured(upper: &[(f64, f64)], lower: &[(f64, f64)]) -> Result<Self, InvalidValue> {
+        fit_shear(upper, lower).map(|f| f.shear_loop)
+    }
+
+    /// The same loop with a reversal dead band: a change of direction counts as a turning point
+    /// only once γ has moved back by more than `band` (rad) from its extreme, so the jitter of an
+    /// iterative solver does not start minor loops. Negative or NaN bands are treated as 0.
+    #[must_use]
+    pub fn with_deadband(mut self, band_rad: f64) -> Self {
+        self.deadband = if band_rad > 0.0 { band_rad } else { 0.0 };
+        self
+    }
+
+    /// The reversal dead band, rad.
+    pub fn deadband(&self) -> f64 {
+        self.deadband
+    }
+
+    /// Shear stiffness G, N/(m·rad).
+    pub fn stiffness(&self) -> f64 {
+        self.stiffness
+    }
+
+    /// Half the loop width at `gamma` (rad), N/m: HG up to 0.5°, linear to HG5 at 5°, HG5
+    /// beyond; even in γ.
+    pub fn half_width(&self, gamma: f64) -> f64 {
+        let x = gamma.abs();
+        let (lo, hi) = KES_SHEAR_ANGLES;
+        if x <= lo {
+            self.hg
+        } else if x >= hi {
+            self.hg5
+        } else {
+            self.hg + (self.hg5 - self.hg) * (x - lo) / (hi - lo)
+        }
+    }
+
+    /// d h/dγ at `gamma` (the slope of the half width; the value right of a kink).
+    fn half_width_slope(&self, gamma: f64) -> f64 {
+        let x = gamma.abs();
+        let (lo, hi) = KES_SHEAR_ANGLES;
+        if x >= lo && x < hi {
+            (self.hg5 - self.hg) / (hi - lo) * gamma.signum()
+        } else {
+            0.0
+        }
+    }
+
+    /// The branch travelled while γ rises, `Gγ + h(|γ|)`, N/m.
+    pub fn upper(&self, gamma: f64) -> f64 {
+        self.stiffness * gamma + self.half_width(gamma)
+    }
+
+    /// The branch travelled while γ falls, `Gγ − h(|γ|)`, N/m.
+    pub fn lower(&self, gamma: f64) -> f64 {
+        self.stiffness * gamma - self.half_width(gamma)
+    }
+
+    /// Whether the loop has hysteresis (2HG or 2HG5 > 0); an elastic one needs no state.
+    pub fn is_hysteretic(&self) -> bool {
+        self.hg > 0.0 || self.hg5 > 0.0
+    }
+
+    /// The join angle Δ_j, rad: a curve from a turning point on a branch reaches the opposite
+    /// branch after Δ_j, the initial curve reaches its branch after Δ_j/2. 0 when elastic.
+    pub fn join_angle(&self) -> f64 {
+        self.join
+    }
+
+    /// The slope dτ/dγ of the initial curve at rest, N/(m·rad): `G + 4HG/Δ_j` (3G unless the
+    /// join angle is capped); G when elastic.
+    pub fn initial_slope(&self) -> f64 {
+        if self.join > 0.0 {
+            self.stiffness + 4.0 * self.hg / self.join
+        } else {
+            self.stiffness
+        }
+    }
+
+    /// An upper bound of [`ShearState::tangent`] over every state and angle, N/(m·rad):
+    /// `G + |HG5 − HG|/4.5° + 4·max(HG, HG5)/Δ_j` (the steepest start of a curve).
+    pub fn max_tangent(&self) -> f64 {
+        let growth = (self.hg5 - self.hg).abs() / (KES_SHEAR_ANGLES.1 - KES_SHEAR_ANGLES.0);
+        if self.join > 0.0 {
+            self.stiffness + growth + 4.0 * self.hg.max(self.hg5) / self.join
+        } else {
+            self.stiffness
+        }
+    }
+
+    /// The branch travelled in direction `d` (+1 rising, −1 falling) and the opposite one.
+    #[inline]
+    fn branches(&self, gamma: f64, rising: bool) -> (f64, f64) {
+        let (g, h) = (self.stiffness * gamma, self.half_width(gamma));
+        if rising {
+            (g + h, g - h)
+        } else {
+            (g - h, g + h)
+        }
+    }
+
+    /// Slopes of the target and opposite branches.
+    #[inline]
+    fn branch_slopes(&self, gamma: f64, rising: bool) -> (f64, f64) {
+        let dh = self.half_width_slope(gamma);
+        let g = self.stiffness;
+        if rising {
+            (g + dh, g - dh)
+        } else {
+            (g - dh, g + dh)
+        }
+    }
+
+    /// The initial curve from rest at `gamma`: `sign(γ)·(upper(|γ|) − 2h·q)`, q = ½(1 − 2|γ|/Δ_j)².
+    fn initial_curve(&self, gamma: f64) -> f64 {
+        let x = gamma.abs();
+        let (up, lo) = self.branches(x, true);
+        let r = if self.join > 0.0 {
+            (1.0 - 2.0 * x / self.join).max(0.0)
+        } else {
+            0.0
+        };
+        let q = 0.5 * r * r;
+        (up - (up - lo) * q).copysign(gamma)
+    }
+
+    /// dτ/dγ of the initial curve (even in γ).
+    fn initial_slope_at(&self, gamma: f64) -> f64 {
+        let x = gamma.abs();
+        let (up, lo) = self.branches(x, true);
+        let (dup, dlo) = self.branch_slopes(x, true);
+        let (r, dr) = if self.join > 0.0 && 2.0 * x < self.join {
+            (1.0 - 2.0 * x / self.join, -2.0 / self.join)
+        } else {
+            (0.0, 0.0)
+        };
+        let (q, dq) = (0.5 * r * r, r * dr);
+        dup - (dup - dlo) * q - (up - lo) * dq
+    }
+}
+
+/// What a [`ShearState`] is travelling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    /// The initial curve from rest.
+    Virgin,
+    /// γ rising after a turning point (heading for the upper branch).
+    Rising,
+    /// γ falling after a turning point (heading for the lower branch).
+    Falling,
+}
+
+/// The shear hysteresis state of one cell (or cell corner): the last angle, the extreme of the
+/// current direction of travel, and the turning point of the curve it travels. Five words,
+/// `Copy`, O(1) to evaluate and update.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShearState {
+    angle: f64,
+    extreme: f64,
+    turn: f64,
+    q0: f64,
+    mode: Mode,
+}
+
+impl Default for ShearState {
+    fn default() -> Self {
+        Self::VIRGIN
+    }
+}
+
+impl ShearState {
+    /// At rest, never sheared.
+    pub const VIRGIN: Self = Self {
+        angle: 0.0,
+        extreme: 0.0,
+        turn: 0.0,
+        q0: 0.5,
+        mode: Mode::Virgin,
+    };
+
+    /// The last committed angle, rad.
+    pub fn angle(&self) -> f64 {
+        self.angle
+    }
+
+    /// The last turning point `(γ_t, τ_t)` on `l`, or `None` while on the initial curve.
+    pub fn turning_point(&self, l: &ShearLoop) -> Option<(f64, f64)> {
+        (self.mode != Mode::Virgin).then(|| (self.turn, self.eval(l, self.turn)))
+    }
+
+    /// Shear force per width τ (N/m) at `gamma` (rad) if the cell moved there now, without
+    /// committing (for the iterations inside a step). O(1). A non-finite angle gives NaN.
+    #[inline]
+    pub fn stress(&self, l: &ShearLoop, gamma: f64) -> f64 {
+        match self.advance(l, gamma) {
+            Some(next) => next.eval(l, gamma),
+            None => f64::NAN,
+        }
+    }
+
+    /// dτ/dγ (N/(m·rad)) at `gamma` on the curve [`ShearState::stress`] would use, without
+    /// committing: finite, at least `G − |HG5 − HG|/4.5° > 0` and at most
+    /// [`ShearLoop::max_tangent`]. At a kink (0.5°, 5°, where a curve from inside the loop meets
+    /// its branch) the slope on the side of larger |γ − γ_t| is returned.
+    #[inline]
+    pub fn tangent(&self, l: &ShearLoop, gamma: f64) -> f64 {
+        match self.advance(l, gamma) {
+            Some(next) => next.slope(l, gamma),
+            None => f64::NAN,
+        }
+    }
+
+    /// Move the cell to `gamma` (rad), detecting a reversal, and return τ (N/m). O(1). A
+    /// non-finite angle returns NaN and leaves the state as it was.
+    #[inline]
+    pub fn update(&mut self, l: &ShearLoop, gamma: f64) -> f64 {
+        match self.advance(l, gamma) {
+            Some(next) => {
+                *self = next;
+                next.eval(l, gamma)
+            }
+            None => f64::NAN,
+        }
+    }
+
+    /// τ on the curve currently travelled at `gamma`, without reversal detection.
+    pub fn branch_stress(&self, l: &ShearLoop, gamma: f64) -> f64 {
+        self.eval(l, gamma)
+    }
+
+    /// Normalised distance q from the target branch on the current curve, and dq/dγ.
+    #[inline]
+    fn distance(&self, l: &ShearLoop, gamma: f64) -> (f64, f64) {
+        let rising = self.mode == Mode::Rising;
+        let s = if rising {
+            gamma - self.turn
+        } else {
+            self.turn - gamma
+        };
+        if s <= 0.0 || l.join <= 0.0 {
+            return (self.q0, 0.0);
+        }
+        let u = s / l.join;
+        let q = self.q0 - progress(u);
+        if q <= 0.0 {
+            return (0.0, 0.0);
+        }
+        // dq/dγ = −φ′(u)/Δ_j · ds/dγ, ds/dγ = ±1.
+        let dq = -progress_slope(u) / l.join;
+        (q, if rising { dq } else { -dq })
+    }
+
+    #[inline]
+    fn eval(&self, l: &ShearLoop, gamma: f64) -> f64 {
+        if !l.is_hysteretic() {
+            return l.stiffness * gamma;
+        }
+        match self.mode {
+            Mode::Virgin => l.initial_curve(gamma),
+            Mode::Rising | Mode::Falling => {
+                let (target, opposite) = l.branches(gamma, self.mode == Mode::Rising);
+                let (q, _) = self.distance(l, gamma);
+                target + (opposite - target) * q
+            }
+        }
+    }
+
+    #[inline]
+    fn slope(&self, l: &ShearLoop, gamma: f64) -> f64 {
+        if !l.is_hysteretic() {
+            return l.stiffness;
+        }
+        match self.mode {
+            Mode::Virgin => l.initial_slope_at(gamma),
+            Mode::Rising | Mode::Falling => {
+                let rising = self.mode == Mode::Rising;
+                let (target, opposite) = l.branches(gamma, rising);
+                let (dt, dop) = l.branch_slopes(gamma, rising);
+                let (q, dq) = self.distance(l, gamma);
+                dt + (dop - dt) * q + (opposite - target) * dq
+            }
+        }
+    }
+
+    /// The state after moving to `gamma` (None for a non-finite angle).
+    #[inline]
+    fn advance(&self, l: &ShearLoop, gamma: f64) -> Option<Self> {
+        if !gamma.is_finite() {
+            return None;
+        }
+        if !l.is_hysteretic() {
+            return Some(Self {
+                angle: gamma,
+                extreme: gamma,
+                ..*self
+            });
+        }
+        // Direction of travel: +1 rising, −1 falling, 0 at rest on the initial curve.
+        let dir = match self.mode {
+            Mode::Virgin => {
+                if self.extreme > 0.0 {
+                    1.0
+                } else if self.extreme < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                }
+            }
+            Mode::Rising => 1.0,
+            Mode::Falling => -1.0,
+        };
+        let back = dir * (self.extreme - gamma);
+        if back <= 0.0 || dir == 0.0 {
+            // Onwards (or from rest): a new extreme.
+            return Some(Self {
+                angle: gamma,
+                extreme: gamma,
+                ..*self
+            });
+        }
+        if back <= l.deadband {
+            // Inside the dead band: back along the current curve, the extreme kept.
+            return Some(Self {
+                angle: gamma,
+                ..*self
+            });
+        }
+        // A reversal, at the edge of the dead band (the extreme itself without one).
+        let turn = if l.deadband > 0.0 {
+            self.extreme - dir * l.deadband
+        } else {
+            self.extreme
+        };
+        let tau_t = self.eval(l, turn);
+        let rising = dir < 0.0;
+        let (target, opposite) = l.branches(turn, rising);
+        let width = opposite - target;
+        let q0 = if width.abs() > 0.0 {
+            ((tau_t - target) / width).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        Some(Self {
+            angle: gamma,
+            extreme: gamma,
+            turn,
+            q0,
+            mode: if rising { Mode::Rising } else { Mode::Falling },
+        })
+    }
+}
+
+/// G, 2HG and 2HG5 read off two branches as KES-FB1 defines them. `upper` and `lower` are
+/// `(angle rad, force N/m)` with the angle increasing and covering ±5°: G is the mean of the
+/// four mean slopes between 0.5° and 5° (each branch, each sign; a mean slope is the secant,
+/// the mean of the derivative), 2HG and 2HG5 the mean widths at ±0.5° and ±5°. The branches are
+/// interpolated linearly between points.
+fn kes_values(upper: &[(f64, f64)], lower: &[(f64, f64)]) -> (f64, f64, f64) {
+    let (lo, hi) = KES_SHEAR_ANGLES;
+    let at = |pts: &[(f64, f64)], x: f64| linear_at(pts, x);
+    let slope = |pts: &[(f64, f64)]| {
+        0.5 * ((at(pts, hi) - at(pts, lo)) + (at(pts, -lo) - at(pts, -hi))) / (hi - lo)
+    };
+    let g = 0.5 * (slope(upper) + slope(lower));
+    let width = |x: f64| 0.5 * ((at(upper, x) - at(lower, x)) + (at(upper, -x) - at(lower, -x)));
+    (g, width(lo), width(hi))
+}
+
+/// Linear interpolation in points sorted by x (constant beyond the ends).
+fn linear_at(pts: &[(f64, f64)], x: f64) -> f64 {
+    let k = pts.partition_point(|p| p.0 < x);
+    if k == 0 {
+        return pts.first().map_or(f64::NAN, |p| p.1);
+    }
+    if k >= pts.len() {
+        return pts.last().map_or(f64::NAN, |p| p.1);
+    }
+    let ((x0, y0), (x1, y1)) = (pts[k - 1], pts[k]);
+    if x1 <= x0 {
+        return y1;
+    }
+    y0 + (y1 - y0) * (x - x0) / (x1 - x0)
+}
+
+/// What a KES-FB1 shear tester reports for a loop.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KesShearTest {
+    /// G: mean slope between 0.5° and 5° over both branches and both signs, N/(m·rad).
+    pub g: f64,
+    /// 2HG: mean loop width at ±0.5°, N/m.
+    pub two_hg: f64,
+    /// 2HG5: mean loop width at ±5°, N/m.
+    pub two_hg5: f64,
+    /// The recorded cycle `(γ rad, τ N/m)`: 0 → +8° → −8° → +8°.
+    pub loop_points: Vec<(f64, f64)>,
+}
+
+/// Run a virtual KES-FB1 shear test on `l`: shear from rest to +8°, back to −8° and to +8° again,
+/// with `steps_per_deg` samples per degree (±0.5° and ±5° are sampled exactly when it is even),
+/// and measure G, 2HG and 2HG5 on the loop this leaves: the lower branch from the pass +8° → −8°,
+/// the upper from −8° → +8°.
+pub fn kes_shear_test(l: &ShearLoop, steps_per_deg: usize) -> KesShearTest {
+    let n = (8 * steps_per_deg).max(2);
+    let max = KES_MAX_SHEAR_ANGLE;
+    let leg = |from: f64, to: f64, steps: usize| {
+        (1..=steps).map(move |i| from + (to - from) * i as f64 / steps as f64)
+    };
+    let mut state = ShearState::VIRGIN;
+    let mut loop_points = vec![(0.0, 0.0)];
+    for g in leg(0.0, max, n) {
+        loop_points.push((g, state.update(l, g)));
+    }
+    let mut lower: Vec<(f64, f64)> = leg(max, -max, 2 * n)
+        .map(|g| (g, state.update(l, g)))
+        .collect();
+    loop_points.extend_from_slice(&lower);
+    let upper: Vec<(f64, f64)> = leg(-max, max, 2 * n)
+        .map(|g| (g, state.update(l, g)))
+        .collect();
+    loop_points.extend_from_slice(&upper);
+    lower.reverse();
+    let (g, two_hg, two_hg5) = kes_values(&upper, &lower);
+    KesShearTest {
+        g,
+        two_hg,
+        two_hg5,
+        loop_points,
+    }
+}
+
+/// Result of reducing a measured shear loop to the KES values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShearFit {
+    /// The reconstructed loop of the measured G, 2HG, 2HG5.
+    pub shear_loop: ShearLoop,
+    /// Root-mean-square distance (N/m) of the measured points with 0.5° ≤ |γ| ≤ 5° from the
+    /// reconstructed branches: how far the measured branches are from straight lines.
+    pub rms_residual: f64,
+    /// Number of those points.
+    pub points_used: usize,
+}
+
+/// Check one point of a measured shear branch in KES units `(angle °, force gf/cm)`, given the
+/// points before it; the error's field is the point's index `[i]`.
+pub(crate) fn check_shear_point(
+    before: &[(f64, f64)],
+    point: (f64, f64),
+) -> Result<(), InvalidValue> {
+    let i = before.len();
+    let at = format!("[{i}]");
+    let (a, f) = point;
+    if !(a.is_finite() && f.is_finite()) {
+        return Err(InvalidValue::new(
+            ErrorKind::NotFinite,
+            at,
+            format!("point ({a}, {f})"),
+        ));
+    }
+    if a.abs() > MEASURED_MAX_ANGLE_DEG {
+        return Err(InvalidValue::new(
+            ErrorKind::OutOfRange,
+            at,
+            format!(
+                "angle {a}° lies beyond ±{MEASURED_MAX_ANGLE_DEG}°; KES-FB1 measures to ±8° \
+                 (angles are in degrees)"
+            ),
+        ));
+    }
+    if f.abs() > MEASURED_MAX_FORCE_GF_CM {
+        return Err(InvalidValue::new(
+            ErrorKind::OutOfRange,
+            at,
+            format!(
+                "force {f} gf/cm is implausible for a shear force per width (above \
+                 ±{MEASURED_MAX_FORCE_GF_CM}); a force for the whole specimen, or not gf/cm?"
+            ),
+        ));
+    }
+    if let Some(&(ap, fp)) = before.last() {
+        if a <= ap {
+            return Err(InvalidValue::new(
+                ErrorKind::NonMonotone,
+                at,
+                format!(
+                    "angle {a}° does not increase (previous {ap}°): list each branch with the \
+                     angle increasing; a branch that turns back makes the loop cross itself"
+                ),
+            ));
+        }
+        if f < fp {
+            return Err(InvalidValue::new(
+                ErrorKind::NonMonotone,
+                at,
+                format!("force {f} gf/cm falls (previous {fp}) while the angle increases"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Check a whole measured shear branch in KES units: every point (see [`check_shear_point`]),
+/// at least [`MEASURED_MIN_POINTS`] points, and the KES measuring range −5°…+5° covered.
+pub(crate) fn check_shear_branch(points: &[(f64, f64)]) -> Result<(), InvalidValue> {
+    for i in 0..points.len() {
+        check_shear_point(&points[..i], points[i])?;
+    }
+    check_shear_extent(points)
+}
+
+/// The checks of a complete branch that no single point decides: enough points, −5°…+5° covered.
+pub(crate) fn check_shear_extent(points: &[(f64, f64)]) -> Result<(), InvalidValue> {
+    if points.len() < MEASURED_MIN_POINTS {
+        return Err(InvalidValue::new(
+            ErrorKind::TooShort,
+            "",
+            format!(
+                "{} point(s); a branch needs at least {MEASURED_MIN_POINTS}",
+                points.len()
+            ),
+        ));
+    }
+    let (first, last) = (points[0].0, points[points.len() - 1].0);
+    let need = KES_SHEAR_ANGLES.1 / DEG;
+    // A hair of slack: ±5° given exactly may come back from radians as 4.999…°.
+    let slack = 1e-9 * need;
+    if first > -need + slack || last < need - slack {
+        return Err(InvalidValue::new(
+            ErrorKind::OutOfRange,
+            "",
+            format!(
+                "the branch spans {first}°…{last}°; it must cover −{need}°…+{need}° (the KES \
+                 measuring points; angles are in degrees, not radians)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Check that two measured branches (KES units, each valid alone) do not cross: the lower branch
+/// (angle falling) must not lie above the upper one (angle rising) anywhere both are measured.
+/// The error names the first offending point of either branch (`lower[i]` or `upper[i]`).
+pub(crate) fn check_shear_branches_apart(
+    upper: &[(f64, f64)],
+    lower: &[(f64, f64)],
+) -> Result<(), InvalidValue> {
+    let (from, to) = (
+        upper[0].0.max(lower[0].0),
+        upper[upper.len() - 1].0.min(lower[lower.len() - 1].0),
+    );
+    let scale = upper
+        .iter()
+        .chain(lower)
+        .map(|p| p.1.abs())
+        .fold(0.0, f64::max);
+    let tol = 1e-9 * scale;
+    let crossing = |name: &str, pts: &[(f64, f64)], other: &[(f64, f64)], sign: f64| {
+        pts.iter()
+            .enumerate()
+            .filter(|(_, p)| p.0 >= from && p.0 <= to)
+            .find(|(_, p)| sign * (p.1 - linear_at(other, p.0)) > tol)
+            .map(|(i, p)| {
+                InvalidValue::new(
+                    ErrorKind::Inconsistent,
+                    format!("{name}[{i}]"),
+                    format!(
+                        "at {}° the lower branch ({:.4} gf/cm) lies above the upper ({:.4} \
+                         gf/cm): the branches cross (are `upper` and `lower` swapped?)",
+                        p.0,
+                        if sign > 0.0 {
+                            p.1
+                        } else {
+                            linear_at(other, p.0)
+                        },
+                        if sign > 0.0 {
+                            linear_at(other, p.0)
+                        } else {
+                            p.1
+                        },
+                    ),
+                )
+            })
+    };
+    // The first offending point in angle order, of either branch.
+    let a = crossing("lower", lower, upper, 1.0);
+    let b = crossing("upper", upper, lower, -1.0);
+    let angle_of = |e: &InvalidValue, pts_l: &[(f64, f64)], pts_u: &[(f64, f64)]| {
+        let idx: usize = e
+            .field
+            .split(['[', ']'])
+            .nth(1)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(0);
+        if e.field.starts_with("lower") {
+            pts_l[idx].0
+        } else {
+            pts_u[idx].0
+        }
+    };
+    match (a, b) {
+        (None, None) => Ok(()),
+        (Some(e), None) | (None, Some(e)) => Err(e),
+        (Some(x), Some(y)) => {
+            if angle_of(&x, lower, upper) <= angle_of(&y, lower, upper) {
+                Err(x)
+            } else {
+                Err(y)
+            }
+        }
+    }
+}
+
+/// Reduce a measured shear loop to G, 2HG and 2HG5 as KES-FB1 defines them (the mean slope
+/// between 0.5° and 5° over both branches and both signs — the secant of each, linear between
+/// points —, the mean widths at ±0.5° and ±5°) and reconstruct the loop from them. `upper`
+/// (angle rising) and `lower` (falling) are `(angle rad, force N/m)` points, each listed with
+/// the angle increasing, covering ±5°, the force non-decreasing along each, the lower never
+/// above the upper (the checks of a measured loop in a fabric file, `docs/fabric.md` §7).
+pub fn fit_shear(upper: &[(f64, f64)], lower: &[(f64, f64)]) -> Result<ShearFit, InvalidValue> {
+    let kes = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        pts.iter()
+            .map(|&(a, f)| (a / DEG, units::force_to_kes(f)))
+            .collect()
+    };
+    let (up_kes, lo_kes) = (kes(upper), kes(lower));
+    check_shear_branch(&up_kes).map_err(|e| e.within("upper"))?;
+    check_shear_branch(&lo_kes).map_err(|e| e.within("lower"))?;
+    check_shear_branches_apart(&up_kes, &lo_kes)?;
+    fit_checked(upper, lower)
+}
+
+/// [`fit_shear`] on branches already checked (in KES units, by the caller).
+pub(crate) fn fit_checked(
+    upper: &[(f64, f64)],
+    lower: &[(f64, f64)],
+) -> Result<ShearFit, InvalidValue> {
+    let (g, two_hg, two_hg5) = kes_values(upper, lower);
+    if g.is_nan() || g <= 0.0 {
+        return Err(InvalidValue::new(
+            ErrorKind::Inconsistent,
+            "",
+            format!(
+                "the mean slope between 0.5° and 5° is {:.4} gf/(cm·deg); a shear loop must \
+                 rise with the angle",
+                units::shear_stiffness_to_kes(g)
+            ),
+        ));
+    }
+    let shear_loop = ShearLoop::from_kes(g, two_hg.max(0.0), Some(two_hg5.max(0.0)))?;
+    let (lo, hi) = KES_SHEAR_ANGLES;
+    let residuals: Vec<f64> = upper
+        .iter()
+        .map(|&(a, f)| (a, f - shear_loop.upper(a)))
+        .chain(lower.iter().map(|&(a, f)| (a, f - shear_loop.lower(a))))
+        .filter(|(a, _)| a.abs() >= lo && a.abs() <= hi)
+        .map(|(_, r)| r)
+        .collect();
+    let rms = if residuals.is_empty() {
+        0.0
+    } else {
+        (residuals.iter().map(|r| r * r).sum::<f64>() / residuals.len() as f64).sqrt()
+    };
+    Ok(ShearFit {
+        shear_loop,
+        rms_residual: rms,
+        points_used: residuals.len(),
+    })
+}
+
+/// Samples of a [`ShearCurve`].
+const CURVE_SAMPLES: usize = 512;
+
+/// Smallest shear angle (rad) a [`ShearCurve`]'s secant is taken at when the curve hardly shears:
+/// it bounds the derived stiffness for data that imply a nearly shear-rigid weave.
+const MIN_SECANT_ANGLE: f64 = 1e-4;
+
+/// The loading shear curve γ(τ) a fabric's warp, weft and 45° bias loading branches imply, by
+/// inverting the trellis relation of [`crate::bias_from_shear`]:
+/// `φ₄₅(2τ) = ½ φ_v(τ) + ½ φ_u(τ) + √(1 + sin γ) − 1`. For a bias loop derived from KES shear values
+/// it returns their loading angle (stick below HG, slope G, saturation at the locking angle); for
+/// measured bias curves it is the shear those curves imply. Tabulated at `τ_k = τ_max (k/N)²`
+/// (fine where the stick ends), odd in τ, non-decreasing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShearCurve {
+    tau_max: f64,
+    gamma: Vec<f64>,
+}
+
+impl ShearCurve {
+    /// Build from a fabric's loading branches (the 45° bias; 135° is not used).
+    pub fn from_fabric(fabric: &Fabric) -> Self {
+        let d = &fabric.tensile;
+        let tau_max = 0.5
+            * d.bias45
+                .max_force()
+                .min(2.0 * d.warp.max_force())
+                .min(2.0 * d.weft.max_force());
+        let mut last: f64 = 0.0;
+        let gamma = (0..=CURVE_SAMPLES)
+            .map(|k| {
+                let tau = tau_max * (k as f64 / CURVE_SAMPLES as f64).powi(2);
+                let s = d.bias45.strain(Branch::Loading, 2.0 * tau)
+                    - 0.5
+                        * (d.warp.strain(Branch::Loading, tau)
+                            + d.weft.strain(Branch::Loading, tau));
+                let sin_g = ((1.0 + s.max(0.0)).powi(2) - 1.0).clamp(0.0, 1.0);
+                // Keep γ non-decreasing (measured curves can dip slightly).
+                last = last.max(sin_g.asin());
+                last
+            })
+            .collect();
+        Self { tau_max, gamma }
+    }
+
+    /// The largest tabulated shear force per width, N/m.
+    pub fn max_force(&self) -> f64 {
+        self.tau_max
+    }
+
+    /// Shear angle at shear force per width `tau` (N/m), rad; odd in τ, constant beyond τ_max.
+    pub fn angle(&self, tau: f64) -> f64 {
+        let x =
+            ((tau.abs() / self.tau_max).sqrt() * CURVE_SAMPLES as f64).min(CURVE_SAMPLES as f64);
+        let k = (x as usize).min(CURVE_SAMPLES - 1);
+        let (a, b) = (
+            k as f64 / CURVE_SAMPLES as f64,
+            (k + 1) as f64 / CURVE_SAMPLES as f64,
+        );
+        let t = ((tau.abs() / self.tau_max).min(1.0) - a * a) / (b * b - a * a);
+        let g = self.gamma[k] + t * (self.gamma[k + 1] - self.gamma[k]);
+        g.copysign(tau)
+    }
+
+    /// The shear force per width (N/m) at which the curve reaches `gamma` (rad, ≥ 0), by
+    /// bisection; τ_max when it never does.
+    pub fn force(&self, gamma: f64) -> f64 {
+        if self.angle(self.tau_max) <= gamma {
+            return self.tau_max;
+        }
+        let (mut lo, mut hi) = (0.0, self.tau_max);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if self.angle(mid) < gamma {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    /// Secant stiffness τ/γ at shear angle `gamma` (rad), N/(m·rad). When the curve never reaches
+    /// `gamma` the secant at τ_max is returned.
+    pub fn secant_stiffness(&self, gamma: f64) -> f64 {
+        if self.angle(self.tau_max) <= gamma {
+            return self.tau_max / self.angle(self.tau_max).max(f64::MIN_POSITIVE);
+        }
+        self.force(gamma) / gamma
+    }
+
+    /// The elastic-with-hysteresis loop this loading curve implies, measured as KES-FB1 would on
+    /// a loading branch: G = the mean slope of τ(γ) between 0.5° and 5°, HG = τ(0.5°) − G·0.5°
+    /// (clamped at 0), the half width constant (one branch cannot tell the growth of the width
+    /// from the slope). When the curve does not reach 5° the slope is taken up to its largest
+    /// angle; when it does not reach 0.5° (or the slope is not positive) the loop is elastic with
+    /// the secant stiffness at its largest angle (taken at least at 1e-4 rad, which bounds the
+    /// stiffness of data implying a shear-rigid weave).
+    pub fn to_loop(&self) -> ShearLoop {
+        let (lo, hi) = KES_SHEAR_ANGLES;
+        let top = self.angle(self.tau_max);
+        let hi = hi.min(top);
+        let secant = || self.tau_max / top.max(MIN_SECANT_ANGLE);
+        let elastic = |g: f64| ShearLoop {
+            stiffness: g,
+            hg: 0.0,
+            hg5: 0.0,
+            join: 0.0,
+            deadband: 0.0,
+        };
+        if hi <= lo {
+            return elastic(secant());
+        }
+        let (t_lo, t_hi) = (self.force(lo), self.force(hi));
+        let g = (t_hi - t_lo) / (hi - lo);
+        if !(g > 0.0 && g.is_finite()) {
+            return elastic(secant());
+        }
+        let two_hg = 2.0 * (t_lo - g * lo).max(0.0);
+        ShearLoop::from_kes(g, two_hg, None).unwrap_or_else(|_| elastic(g))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn cotton() -> ShearLoop {
+        ShearLoop::from_kes_units(1.5, 2.5, Some(4.5)).expect("valid")
+    }
+
+    #[test]
+    fn branches_and_widths_follow_the_kes_values() {
+        let l = cotton();
+        assert_relative_eq!(l.half_width(0.0), units::force_from_kes(1.25));
+        assert_relative_eq!(l.half_width(0.3 * DEG), units::force_from_kes(1.25));
+        assert_relative_eq!(
+            l.half_width(2.75 * DEG),
+            units::force_from_kes(1.75),
+            max_relative = 1e-12
+        );
+        assert_relative_eq!(
+            l.half_width(-7.0 * DEG),
+            units::force_from_kes(2.25),
+            max_relative = 1e-12
+        );
+        for g in [-0.1, -0.03, 0.004, 0.05, 0.12] {
+            assert_relative_eq!(l.lower(-g), -l.upper(g), max_relative = 1e-15);
+        }
+        // Δ_j = 2HG/G = 2.5/1.5 degrees; initial slope 3G.
+        assert_relative_eq!(l.join_angle(), 2.5 / 1.5 * DEG, max_relative = 1e-12);
+        assert_relative_eq!(l.initial_slope(), 3.0 * l.stiffness(), max_relative = 1e-12);
+    }
+
+    #[test]
+    fn invalid_values_are_rejected() {
+        let kind = |r: Result<ShearLoop, InvalidValue>| r.expect_err("invalid").kind;
+        assert_eq!(
+            kind(ShearLoop::from_kes(0.0, 1.0, None)),
+            ErrorKind::OutOfRange
+        );
+        assert_eq!(
+            kind(ShearLoop::from_kes(-1.0, 1.0, None)),
+            ErrorKind::Negative
+        );
+        assert_eq!(
+            kind(ShearLoop::from_kes(1.0, f64::NAN, None)),
+            ErrorKind::NotFinite
+        );
+        assert_eq!(
+            kind(ShearLoop::from_kes(1.0, 1.0, Some(-2.0))),
+            ErrorKind::Negative
+        );
+        // The lower branch would fall: 2HG5 − 2HG > 2G·4.5°.
+        assert_eq!(
+            kind(ShearLoop::from_kes_units(0.5, 0.4, Some(5.0))),
+            ErrorKind::Inconsistent
+        );
+    }
+
+    #[test]
+    fn the_join_angle_is_capped_at_two_and_a_half_degrees() {
+        let l = ShearLoop::from_kes_units(0.5, 4.0, None).expect("valid");
+        assert_relative_eq!(l.join_angle(), MAX_JOIN_ANGLE, max_relative = 1e-15);
+        assert!(l.initial_slope() > 3.0 * l.stiffness());
+        // Without 2HG the width at 5° sets the join.
+        let l = ShearLoop::from_kes_units(1.0, 0.0, Some(1.0)).expect("valid");
+        assert_relative_eq!(l.join_angle(), 1.0 * DEG, max_relative = 1e-12);
+        assert_relative_eq!(l.initial_slope(), l.stiffness(), max_relative = 1e-12);
+    }
+
+    #[test]
+    fn elastic_loop_is_linear_and_needs_no_state() {
+        let l = ShearLoop::elastic(80.0).expect("valid");
+        assert!(!l.is_hysteretic());
+        let mut st = ShearState::VIRGIN;
+        for g in [0.0, 0.05, -0.02, 0.1, 0.03] {
+            assert_relative_eq!(st.update(&l, g), 80.0 * g, max_relative = 1e-15);
+            assert_relative_eq!(st.tangent(&l, g), 80.0);
+        }
+        assert_relative_eq!(l.initial_slope(), 80.0);
+        assert_relative_eq!(l.max_tangent(), 80.0);
+    }
+
+    #[test]
+    fn non_finite_angles_leave_the_state_alone() {
+        let l = cotton();
+        let mut st = ShearState::VIRGIN;
+        st.update(&l, 0.02);
+        let before = st;
+        assert!(st.update(&l, f64::NAN).is_nan());
+        assert!(st.stress(&l, f64::INFINITY).is_nan());
+        assert!(st.tangent(&l, f64::NAN).is_nan());
+        assert_eq!(st, before);
+    }
+
+    /// The alternative the module doc rejects: a curve that always joins smoothly, with its span
+    /// proportional to the distance left (constant initial slope). A small cycle a → b → a from
+    /// the lower branch then creates energy; the truncated Masing curve dissipates.
+    #[test]
+    fn a_smooth_join_from_inside_the_loop_would_create_energy() {
+        let l = cotton();
+        let (g, h) = (l.stiffness(), l.half_width(0.0));
+        let dj = l.join_angle();
+        let (a, b) = (0.0, 0.2 * dj);
+        // Rising from the lower branch at a: the same curve in both models.
+        let rising = |x: f64| {
+            let q = 1.0 - progress((x - a) / dj);
+            g * x + h - 2.0 * h * q.max(0.0)
+        };
+        // Falling from b; q₀ = its normalised distance from the lower branch.
+        let q0 = (rising(b) - (g * b - h)) / (2.0 * h);
+        let smooth = |x: f64| {
+            let span = q0 * dj;
+            let u = ((b - x) / span).min(1.0);
+            g * x - h + 2.0 * h * q0 * (1.0 - u) * (1.0 - u)
+        };
+        // Onto the lower branch at a (falling from +0.2 rad), then up to b.
+        let mut st = ShearState::VIRGIN;
+        st.update(&l, 0.2);
+        st.update(&l, a);
+        assert_relative_eq!(st.stress(&l, a), l.lower(a), max_relative = 1e-12);
+        st.update(&l, b);
+        assert_relative_eq!(st.stress(&l, b), rising(b), max_relative = 1e-12);
+        let n = 20_000;
+        let dx = (b - a) / n as f64;
+        let (mut w_smooth, mut w_masing) = (0.0, 0.0);
+        for i in 0..n {
+            let x = a + (i as f64 + 0.5) * dx;
+            w_smooth += (rising(x) - smooth(x)) * dx;
+            w_masing += (rising(x) - st.stress(&l, x)) * dx;
+        }
+        assert!(w_smooth < 0.0, "smooth-join cycle dissipates {w_smooth}");
+        assert!(w_masing > 0.0, "Masing cycle dissipates {w_masing}");
+    }
+}

@@ -1,0 +1,218 @@
+//! What a step reports: its stages, the errors that stop it (and the checks that raise them),
+//! its per-stage timings and its diagnostics.
+
+use std::time::Duration;
+
+use super::V3;
+use crate::cloth::Cloth;
+use crate::params::{ParamError, StepParams};
+use crate::state::ClothState;
+
+/// The stages of a step, for timings and errors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// Positions and velocities handed to the step.
+    Input,
+    /// Normals, curvatures and bending forces.
+    Bending,
+    /// Internal axial forces.
+    InternalForces,
+    /// Unconstrained velocity.
+    Velocity,
+    /// The air pressure force of a wet cloth.
+    Pressure,
+    /// Shape-constraint targets and iterations.
+    ShapeConstraints,
+    /// A collision pass (the hook).
+    Collision,
+    /// Position and hysteresis update.
+    Update,
+}
+
+/// A step that could not be completed; the state is as it was before the step.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// A parameter is outside its range.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    /// The state does not match the cloth.
+    #[error("the state has {found} {what}, the cloth {expected}")]
+    Mismatch {
+        /// What is counted.
+        what: &'static str,
+        /// The cloth's count.
+        expected: usize,
+        /// The state's count.
+        found: usize,
+    },
+    /// The step would stretch an edge beyond `StepParams::divergence_strain`.
+    #[error(
+        "diverging: edge {edge} would reach strain {strain:.3} (limit {limit}) at time {time} s; Δt too large or tolerances too loose"
+    )]
+    Diverged {
+        /// The edge.
+        edge: usize,
+        /// Its strain |l/l⁰ − 1| after the step.
+        strain: f64,
+        /// The limit.
+        limit: f64,
+        /// Simulated time at the start of the step.
+        time: f64,
+    },
+    /// A value became NaN or infinite.
+    #[error("non-finite {quantity} at {location} {index} in stage {stage:?} (time {time} s)")]
+    NonFinite {
+        /// The stage that produced it.
+        stage: Stage,
+        /// What quantity.
+        quantity: &'static str,
+        /// "node" or "edge".
+        location: &'static str,
+        /// Its index.
+        index: usize,
+        /// Simulated time at the start of the step.
+        time: f64,
+    },
+}
+
+/// Per-stage wall time of one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageTimings {
+    /// Normals, curvature, bending force.
+    pub bending: Duration,
+    /// Internal forces.
+    pub internal: Duration,
+    /// Unconstrained velocity.
+    pub velocity: Duration,
+    /// Targets and constraint iterations.
+    pub shape: Duration,
+    /// Collision hook: the passes between shape iterations.
+    pub collision: Duration,
+    /// Collision hook: the transfer of body motion before the shape constraints.
+    pub transfer: Duration,
+    /// Update and diagnostics.
+    pub update: Duration,
+    /// The air pressure force ([`Solver::pressure`](super::Solver::pressure); zero when off).
+    pub pressure: Duration,
+}
+
+impl StageTimings {
+    /// Sum of all stages.
+    pub fn total(&self) -> Duration {
+        self.bending
+            + self.internal
+            + self.velocity
+            + self.transfer
+            + self.shape
+            + self.collision
+            + self.update
+            + self.pressure
+    }
+}
+
+/// Diagnostics of one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Internal-force iterations (axial phase, diagonal phase).
+    pub internal_iterations: [usize; 2],
+    /// Final E over its value at p = 0 (1 = nothing balanced, 0 = all external load carried).
+    pub internal_residual: f64,
+    /// Shape iterations over all passes.
+    pub shape_iterations: usize,
+    /// Conjugate-gradient iterations over all passes (Newton shape method only).
+    pub cg_iterations: usize,
+    /// RMS of the per-node length error R after the last iteration, m.
+    pub shape_residual: f64,
+    /// Largest |ε − ε̄| over the edges after the update (stretch-only edges: excess only).
+    pub max_strain_error: f64,
+    /// Kinetic energy after the step, J.
+    pub kinetic_energy: f64,
+    /// Fastest node after the step, m/s.
+    pub max_speed: f64,
+    /// Edges whose force per width lay above the measured range (strain extrapolated).
+    pub extrapolated_edges: usize,
+    /// The tolerance factor the policy applied (1 = tight).
+    pub tolerance_factor: f64,
+    /// Wall time per stage.
+    pub timings: StageTimings,
+}
+
+/// The checks before a step: parameters in range, a state that matches the cloth, finite
+/// positions and velocities.
+pub(super) fn check_input(
+    cloth: &Cloth,
+    state: &ClothState,
+    params: &StepParams,
+) -> Result<(), StepError> {
+    params.validate()?;
+    let topo = cloth.topology();
+    let (n, ne) = (topo.node_count(), topo.edges().len());
+    for (what, expected, found) in [
+        ("positions", n, state.positions.len()),
+        ("velocities", n, state.velocities.len()),
+        ("edge forces", ne, state.axial_force.len()),
+        ("tensile states", ne, state.tensile.len()),
+        ("bending states", n, state.bending.len()),
+        (
+            "cell shear angles",
+            topo.cells().len(),
+            state.shear_angle.len(),
+        ),
+    ] {
+        if expected != found {
+            return Err(StepError::Mismatch {
+                what,
+                expected,
+                found,
+            });
+        }
+    }
+    guard_nodes(Stage::Input, "position", &state.positions, state.time)?;
+    guard_nodes(Stage::Input, "velocity", &state.velocities, state.time)
+}
+
+/// Stop the step (stage `stage`, simulated time `time` at its start) at the first node whose
+/// `quantity` in `values` is NaN or infinite.
+pub(super) fn guard_nodes(
+    stage: Stage,
+    quantity: &'static str,
+    values: &[V3],
+    time: f64,
+) -> Result<(), StepError> {
+    let first = values
+        .iter()
+        .position(|x| !(x.x.is_finite() && x.y.is_finite() && x.z.is_finite()));
+    non_finite(stage, quantity, "node", first, time)
+}
+
+/// Stop the step (stage `stage`, simulated time `time` at its start) at the first edge whose
+/// `quantity` in `values` is NaN or infinite.
+pub(super) fn guard_edges(
+    stage: Stage,
+    quantity: &'static str,
+    values: &[f64],
+    time: f64,
+) -> Result<(), StepError> {
+    let first = values.iter().position(|x| !x.is_finite());
+    non_finite(stage, quantity, "edge", first, time)
+}
+
+/// [`StepError::NonFinite`] at `first`, if any.
+fn non_finite(
+    stage: Stage,
+    quantity: &'static str,
+    location: &'static str,
+    first: Option<usize>,
+    time: f64,
+) -> Result<(), StepError> {
+    match first {
+        Some(index) => Err(StepError::NonFinite {
+            stage,
+            quantity,
+            location,
+            index,
+            time,
+        }),
+        None => Ok(()),
+    }
+}
