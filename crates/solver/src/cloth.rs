@@ -1,12 +1,12 @@
 //! The static description of one piece of cloth for the solver: its topology, the fabric's
 //! characteristics at every edge angle, node masses, and pins (inverse mass 0, fixed or moving).
 
-use atelier_fabric::{AnisotropyForm, Fabric, InvalidValue, MaterialTable};
+use atelier_fabric::{AnisotropyForm, Fabric, InvalidValue, MaterialTable, ShearLoop};
 use atelier_grid::{ClothTopology, EdgeKind, NO_NODE, SLOTS};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use crate::shear::ShearCurve;
+use crate::shear_angle::{ShearMeasure, cell_angle};
 
 /// How a pinned node moves (its position is prescribed; the solver never moves it otherwise).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -99,10 +99,6 @@ pub enum ClothError {
     },
 }
 
-/// Shear angle at which the secant shear stiffness is taken for a fabric without KES shear
-/// values, rad (2°, inside KES's 0.5°–5° range for G).
-const SECANT_SHEAR_ANGLE: f64 = 2.0 * std::f64::consts::PI / 180.0;
-
 /// One piece of cloth: topology, materials, masses and pins. Immutable during a simulation
 /// (pins are set before the first step), except for a pin released with [`Cloth::unpin`].
 #[derive(Clone, Debug)]
@@ -119,8 +115,11 @@ pub struct Cloth {
     axial_list: Vec<u32>,
     diagonal_list: Vec<u32>,
     phase_slot: Vec<u32>,
-    shear: ShearCurve,
-    diagonal_stiffness: Vec<f64>,
+    shear: ShearLoop,
+    locking_angle: f64,
+    /// The angle between each cell's u and v directions at rest, per [`ShearMeasure`]
+    /// (midpoint, corners).
+    cell_rest: [Vec<f64>; 2],
     mass: Vec<f64>,
     inv_mass: Vec<f64>,
     pins: Vec<Pin>,
@@ -146,6 +145,7 @@ pub struct Incidence {
 
 /// How a fabric is turned into a cloth's materials.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct ClothOptions {
     /// Orthotropic interpolation law. Default `PlateTheory` (the thesis form can invert a
     /// tensile loop at angles between the measured ones; see `docs/fabric.md`).
@@ -156,6 +156,12 @@ pub struct ClothOptions {
     /// forces and the step unstable (measured in `docs/solver.md`). Range [0, 1); default 0.01
     /// (5 gf/cm at the KES Fm).
     pub toe_fraction: f64,
+    /// Reversal dead band of every tensile loop as a fraction of its maximum force
+    /// (`TensileLoop::with_deadband`): a force that moves back by less than this does not start
+    /// a minor loop, so iteration jitter in the axial forces does not ratchet minor loops. Set
+    /// here rather than in the step parameters because the loops are built once per cloth.
+    /// Range [0, 0.1); default 1e-3 (0.5 gf/cm at the KES Fm).
+    pub tensile_deadband: f64,
 }
 
 impl Default for ClothOptions {
@@ -163,6 +169,7 @@ impl Default for ClothOptions {
         Self {
             form: AnisotropyForm::PlateTheory,
             toe_fraction: 0.01,
+            tensile_deadband: 1e-3,
         }
     }
 }
@@ -198,10 +205,18 @@ impl Cloth {
         } else {
             0.01
         };
+        let band = if (0.0..0.1).contains(&options.tensile_deadband) {
+            options.tensile_deadband
+        } else {
+            1e-3
+        };
         let (materials, edge_material) = MaterialTable::build(fabric, form, &angles)
             .map(|(t, idx)| {
                 (
-                    t.map_tensile(|l| l.with_linear_toe(toe * l.max_force())),
+                    t.map_tensile(|l| {
+                        l.with_linear_toe(toe * l.max_force())
+                            .with_deadband(band * l.max_force())
+                    }),
                     idx,
                 )
             })
@@ -268,24 +283,34 @@ impl Cloth {
                 phase_slot[e as usize] = k as u32;
             }
         }
-        let shear = ShearCurve::from_fabric(fabric);
-        // A compliant diagonal's spring constant: with the fabric's shear stiffness G a cell of
-        // rest area S sheared by γ stores ½ G γ² S; its two diagonals of rest length d change by
-        // ∓ S γ / d each, so k = G d² / (2 S) per diagonal (k = G for a square cell).
-        let g = fabric.shear.as_ref().map_or_else(
-            || shear.secant_stiffness(SECANT_SHEAR_ANGLE),
-            |s| s.stiffness,
-        );
-        let mut diagonal_stiffness = vec![0.0; topology.edges().len()];
-        for cell in topology.cells() {
-            for d in cell.diagonals {
-                let l = topology.edges()[d as usize].rest_length;
-                diagonal_stiffness[d as usize] = g * l * l / (2.0 * cell.area);
-            }
-        }
+        let shear = fabric
+            .shear_loop()
+            .map_err(|source| ClothError::Material {
+                fabric: fabric.name.clone(),
+                source,
+            })?;
+        let locking_angle = fabric
+            .shear
+            .as_ref()
+            .map_or(atelier_fabric::DEFAULT_LOCKING_ANGLE, |s| s.locking_angle);
+        let rest = |measure: ShearMeasure| -> Vec<f64> {
+            topology
+                .cells()
+                .iter()
+                .map(|c| {
+                    let q = c.nodes.map(|k| {
+                        let [x, y] = topology.rest_positions()[k as usize];
+                        Vector3::new(x, y, 0.0)
+                    });
+                    cell_angle(measure, &q)
+                })
+                .collect()
+        };
+        let cell_rest = [rest(ShearMeasure::Midpoint), rest(ShearMeasure::Corners)];
         Ok(Self {
             shear,
-            diagonal_stiffness,
+            locking_angle,
+            cell_rest,
             topology,
             fabric: fabric.clone(),
             form,
@@ -499,16 +524,22 @@ impl Cloth {
         &self.diagonal_list
     }
 
-    /// The in-plane shear characteristic of the cells.
-    pub fn shear_curve(&self) -> &ShearCurve {
+    /// The fabric's shear loop (KES-FB1 reconstruction, [`ShearLoop`]), which every cell uses.
+    pub fn shear_loop(&self) -> &ShearLoop {
         &self.shear
     }
 
-    /// Spring constant of each diagonal when diagonals are compliant
-    /// (`ConstraintKind::Compliant`), N/m; 0 for axial edges. From the fabric's KES shear
-    /// stiffness G, or when the fabric has none the secant of its shear curve at 2°.
-    pub fn diagonal_stiffness(&self) -> &[f64] {
-        &self.diagonal_stiffness
+    /// The shear locking angle, rad: the cells' shear angle is held within ± this.
+    pub fn locking_angle(&self) -> f64 {
+        self.locking_angle
+    }
+
+    /// The angle between each cell's u and v directions at rest by `measure`, rad.
+    pub fn cell_rest_angles(&self, measure: ShearMeasure) -> &[f64] {
+        match measure {
+            ShearMeasure::Midpoint => &self.cell_rest[0],
+            ShearMeasure::Corners => &self.cell_rest[1],
+        }
     }
 
     /// Node masses μ = m_A·S, kg.

@@ -20,8 +20,6 @@ pub mod long_range;
 pub mod metrics;
 pub mod params;
 pub mod scenes;
-pub mod shape;
-pub mod shear;
 pub mod shear_angle;
 pub mod state;
 pub mod step;
@@ -32,7 +30,7 @@ pub use contact::BodyContact;
 pub use params::{
     ConstraintKind, InternalMethod, ParamError, ShapeMethod, StepParams, TolerancePolicy,
 };
-pub use shear::ShearCurve;
+pub use shear_angle::ShearMeasure;
 pub use state::ClothState;
 pub use step::{
     CollisionHook, HookContext, NoCollision, Solver, Stage, StageTimings, StepError, StepReport,

@@ -134,10 +134,6 @@ pub struct StepParams {
     /// Reversal dead band of the shear loop, rad: an angle change back smaller than this does
     /// not start a minor loop. Range [0, 0.1); default 1e-4 rad (0.006°).
     pub shear_deadband: f64,
-    /// Reversal dead band of the tensile loops as a fraction of each loop's maximum force: a
-    /// force change back smaller than this does not start a minor loop (solver jitter would
-    /// ratchet them). Range [0, 0.1); default 1e-3 (0.5 gf/cm at the KES Fm).
-    pub tensile_deadband: f64,
     /// Tolerance policy. Default `Fixed`.
     pub tolerance_policy: TolerancePolicy,
     /// Treat the bending stiffness of each node implicitly along its normal (a linearised
@@ -196,7 +192,6 @@ impl Default for StepParams {
             shear_measure: ShearMeasure::Midpoint,
             shear_scale: 1.0,
             shear_deadband: 1e-4,
-            tensile_deadband: 1e-3,
             tolerance_policy: TolerancePolicy::Fixed,
             implicit_bending: true,
             bending_tolerance: 1e-6,
@@ -305,12 +300,12 @@ impl StepParams {
             (0.0..=1e3).contains(&self.shear_scale),
             "[0, 1000]",
         )?;
-        for (name, value) in [
-            ("shear_deadband", self.shear_deadband),
-            ("tensile_deadband", self.tensile_deadband),
-        ] {
-            check(name, value, (0.0..0.1).contains(&value), "[0, 0.1)")?;
-        }
+        check(
+            "shear_deadband",
+            self.shear_deadband,
+            (0.0..0.1).contains(&self.shear_deadband),
+            "[0, 0.1) rad",
+        )?;
         match self.shape_method {
             ShapeMethod::Chebyshev { rho } => {
                 check("shape_method.rho", rho, rho > 0.0 && rho < 1.0, "(0, 1)")?

@@ -2,7 +2,7 @@
 //! (positions, velocities, the warm-start axial forces, the hysteresis states). Reusable scratch
 //! lives in [`crate::Solver`], not here.
 
-use atelier_fabric::{BendingState, TensileState};
+use atelier_fabric::{BendingState, ShearState, TensileState};
 use atelier_grid::SLOTS;
 use nalgebra::Vector3;
 
@@ -23,8 +23,10 @@ pub struct ClothState {
     pub tensile: Vec<TensileState>,
     /// Bending hysteresis state of each node's axial slots.
     pub bending: Vec<[BendingState; SLOTS]>,
-    /// Shear angle of each cell from the last step (rad), for reports.
+    /// Shear angle of each cell at the end of the last step (rad), for reports.
     pub shear_angle: Vec<f64>,
+    /// Shear hysteresis state of each cell.
+    pub shear: Vec<ShearState>,
 }
 
 impl ClothState {
@@ -47,6 +49,7 @@ impl ClothState {
             tensile: vec![TensileState::VIRGIN; e],
             bending: vec![[BendingState::VIRGIN; SLOTS]; n],
             shear_angle: vec![0.0; topo.cells().len()],
+            shear: vec![ShearState::VIRGIN; topo.cells().len()],
         }
     }
 

@@ -1,6 +1,7 @@
-//! Stage 2: the internal axial forces p ≥ 0 (43)–(47), by projected steepest descent or its
-//! accelerated variant, axial edges then diagonals; the step-size estimate λ_max, the energy E
-//! and its gradient.
+//! Stage 2: the internal axial forces p ≥ 0 (43)–(47) of the axial edges, by projected steepest
+//! descent or its accelerated variant, to a relative tolerance; the step-size estimate λ_max, the
+//! energy E and its gradient. (The diagonals carry nothing: they are not constraints any more,
+//! `method.md` §2b; the phase machinery keeps its `diagonals` switch for the edge classes.)
 
 use rayon::prelude::*;
 
@@ -26,30 +27,28 @@ fn free_energy(chunk: &mut Vec<f64>, f: &[V3], inv: &[f64]) -> f64 {
 }
 
 impl Solver {
-    /// The internal-force stage: λ_max of both phases estimated when there is none, p warm-started
-    /// from the state's forces, the axial phase then the diagonal phase (tolerances × `factor`),
-    /// and F^m gathered from all of p (less the surface's reaction when a pressure stage is on).
-    /// Returns the iterations of each phase and the final E over its value at p = 0.
+    /// The internal-force stage: λ_max estimated when there is none, p warm-started from the
+    /// state's forces (the diagonals' at zero), the axial phase to `internal_tolerance ×
+    /// factor` of its projected gradient at p = 0 or `internal_max_iterations`, and F^m gathered
+    /// (less the surface's reaction when a pressure stage is on). Returns the iterations, the
+    /// final E over its value at p = 0, and whether the tolerance was met.
     pub(super) fn internal_forces(
         &mut self,
         cloth: &Cloth,
         state: &ClothState,
         params: &StepParams,
         factor: f64,
-    ) -> ([usize; 2], f64) {
+    ) -> (usize, f64, bool) {
         if self.lambda.is_none() {
-            self.lambda = Some([
-                self.estimate_lambda(cloth, false),
-                self.estimate_lambda(cloth, true),
-            ]);
+            self.lambda = Some([self.estimate_lambda(cloth, false), 1.0]);
         }
         self.s.p.copy_from_slice(&state.axial_force);
+        for &e in cloth.diagonal_edge_list() {
+            self.s.p[e as usize] = 0.0;
+        }
         let e0 = self.energy_at_zero(cloth);
-        let iterations = [
-            self.internal_phase(cloth, params, false, factor),
-            self.internal_phase(cloth, params, true, factor),
-        ];
-        self.gather(cloth, true);
+        let (iterations, converged) = self.internal_phase(cloth, params, false, factor);
+        self.gather(cloth, false);
         let e = self.energy(cloth);
         let residual = if e0 > 0.0 { e / e0 } else { 0.0 };
         if self.pressure.is_some() {
@@ -59,7 +58,7 @@ impl Solver {
                 *f -= r;
             }
         }
-        (iterations, residual)
+        (iterations, residual, converged)
     }
 
     /// F^m = F_sum + Σ p d over incident edges (diagonals only when `diagonals`), from p.
@@ -153,14 +152,15 @@ impl Solver {
     }
 
     /// One phase of the internal-force solve (thesis (45)–(47)): projected steepest descent, or
-    /// the accelerated variant; only this phase's p change. Returns the iterations used.
+    /// the accelerated variant; only this phase's p change. Returns the iterations used and
+    /// whether the projected gradient met the tolerance.
     fn internal_phase(
         &mut self,
         cloth: &Cloth,
         params: &StepParams,
         diagonals: bool,
         factor: f64,
-    ) -> usize {
+    ) -> (usize, bool) {
         let edges = cloth.topology().edges();
         let lambda = self.lambda.map_or(1.0, |l| l[usize::from(diagonals)]);
         let mut gamma = params.internal_step / lambda;
@@ -186,7 +186,7 @@ impl Solver {
             self.gather(cloth, diagonals);
             e_start = e_zero;
             if g_ref == 0.0 {
-                return 0;
+                return (0, true);
             }
         }
         let tol = params.internal_tolerance * factor * g_ref;
@@ -194,11 +194,16 @@ impl Solver {
         self.s.p_warm.copy_from_slice(&self.s.p);
         let mut e_old = e_start;
         let mut iterations = 0;
+        let mut converged = false;
         match params.internal_method {
             InternalMethod::SteepestDescent => {
-                while iterations < params.internal_max_iterations {
+                loop {
                     self.gradient(cloth, diagonals);
                     if self.projected_gradient_norm(cloth, diagonals, false) <= tol {
+                        converged = true;
+                        break;
+                    }
+                    if iterations >= params.internal_max_iterations {
                         break;
                     }
                     iterations += 1;
@@ -223,7 +228,8 @@ impl Solver {
                 }
             }
             InternalMethod::Accelerated => {
-                iterations = self.accelerated_phase(cloth, params, diagonals, gamma, tol);
+                (iterations, converged) =
+                    self.accelerated_phase(cloth, params, diagonals, gamma, tol);
                 self.gather(cloth, diagonals);
                 if self.energy(cloth) > e_start * (1.0 + 1e-9) {
                     // Worse than the warm start (a step too long for this geometry): keep the
@@ -231,10 +237,11 @@ impl Solver {
                     self.s.p.copy_from_slice(&self.s.p_warm);
                     self.gather(cloth, diagonals);
                     self.lambda = None;
+                    converged = false;
                 }
             }
         }
-        iterations
+        (iterations, converged)
     }
 
     /// The accelerated internal-force iterations of one phase: FISTA with gradient restart
@@ -242,7 +249,7 @@ impl Solver {
     /// iteration (gather at the extrapolated point; one fused pass for the gradient, the
     /// projected step, the optimality measure and the restart test; the next extrapolation),
     /// all parallel with deterministic chunked reductions. Writes the phase's forces back into
-    /// `s.p`; returns the iterations.
+    /// `s.p`; returns the iterations and whether the projected gradient met `tol`.
     fn accelerated_phase(
         &mut self,
         cloth: &Cloth,
@@ -250,7 +257,7 @@ impl Solver {
         diagonals: bool,
         gamma: f64,
         tol: f64,
-    ) -> usize {
+    ) -> (usize, bool) {
         let list: &[u32] = if diagonals {
             cloth.diagonal_edge_list()
         } else {
@@ -269,6 +276,7 @@ impl Solver {
         resize(&mut s.ph_partial, chunks, [0.0; 2]);
         let mut t: f64 = 1.0;
         let mut iterations = 0;
+        let mut converged = false;
         while iterations < params.internal_max_iterations {
             // F^m at y: the phase's forces from y, the other phase's from p (fixed).
             {
@@ -333,6 +341,7 @@ impl Solver {
                 .fold((0.0, 0.0), |a, b| (a.0 + b[0], a.1 + b[1]));
             iterations += 1;
             if norm2.sqrt() <= tol {
+                converged = true;
                 break;
             }
             let t_next = 0.5 * (1.0 + (1.0 + 4.0 * t * t).sqrt());
@@ -348,7 +357,7 @@ impl Solver {
         for (k, &e) in list.iter().enumerate() {
             s.p[e as usize] = s.ph_p[k];
         }
-        iterations
+        (iterations, converged)
     }
 
     /// Norm of the projected gradient over one phase's edges (components pushing a zero force

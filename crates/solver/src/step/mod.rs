@@ -4,13 +4,16 @@
 //! 1. geometry (`geometry.rs`) and bending force (28)–(32) (`bending.rs`), plus gravity and the
 //!    external forces; the air pressure force of a wet cloth (`pressure.rs`) when
 //!    [`Solver::pressure`] is on;
-//! 2. internal axial forces p ≥ 0 by projected descent (43)–(47), axial edges then diagonals
-//!    (`internal.rs`);
-//! 3. unconstrained velocity (18) (`velocity.rs`), then the collision hook's transfer of body
-//!    motion (`hook.rs`);
-//! 4. shape-constraint targets from the tensile and shear characteristics (`targets.rs`), and the
-//!    constraint iterations (49)–(51) (`shape.rs`), interleaved with collision passes;
-//! 5. position update, hysteresis update, diagnostics (`update.rs`).
+//! 2. internal axial forces p ≥ 0 of the axial edges by projected descent (43)–(47), to a
+//!    relative tolerance (`internal.rs`);
+//! 3. unconstrained velocity (18) with implicit bending along the normals (`velocity.rs`), then
+//!    the collision hook's transfer of body motion (`hook.rs`);
+//! 4. the axial edges' target lengths from the tensile characteristics and the cells' shear
+//!    constraints from the shear loop (`targets.rs`), then the shape stage (49)–(51): the
+//!    constraints solved to a relative tolerance (`projection.rs`: rows, Newton on the
+//!    constraint-space system of [`crate::dual`], or local iterations) before each collision
+//!    pass (`shape.rs`);
+//! 5. position update, hysteresis update (tensile, bending, shear), diagnostics (`update.rs`).
 //!
 //! Nothing in the state changes until every stage has succeeded: a non-finite value stops the
 //! step with the stage and node (or edge), and the state from before the step is kept.
@@ -23,6 +26,7 @@ mod hook;
 mod internal;
 mod par;
 mod pressure;
+pub(crate) mod projection;
 mod report;
 mod scratch;
 mod shape;
@@ -30,7 +34,7 @@ mod targets;
 mod update;
 mod velocity;
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use atelier_grid::SLOTS;
 use nalgebra::Vector3;
@@ -41,6 +45,7 @@ use crate::state::ClothState;
 
 pub(crate) use hook::plane_push;
 pub use hook::{CollisionHook, HookContext, NoCollision, Tie};
+pub use projection::Constraint;
 pub use report::{Stage, StageTimings, StepError, StepReport};
 
 use par::PAR_MIN;
@@ -56,6 +61,8 @@ pub struct Solver {
     s: Scratch,
     /// λ_max(AᵀA) of the axial and diagonal phases, estimated on the first step.
     lambda: Option<[f64; 2]>,
+    /// The shape stage's rows, system and multipliers (kept between steps).
+    projection: projection::ShapeSolver,
     /// External forces per node (N) added in the next steps; empty for none.
     pub external_forces: Vec<V3>,
     /// The air pressure of a wet cloth ([`crate::wet`]): its force at the start of the step joins
@@ -89,6 +96,14 @@ impl Solver {
     /// Forget cached estimates (call when switching to a different cloth or changing pins).
     pub fn reset(&mut self) {
         self.lambda = None;
+        self.projection = projection::ShapeSolver::default();
+    }
+
+    /// Rows of the shape stage's system, and the non-zeros of its lower triangle and of its
+    /// factor (0 before the first step; diagnostics and benches).
+    pub fn shape_system_size(&self) -> (usize, usize, usize) {
+        let (a, l) = self.projection.sizes();
+        (self.projection.rows(), a, l)
     }
 
     /// One step without collisions.
@@ -152,14 +167,18 @@ impl Solver {
         // 2. Internal forces.
         let t0 = Instant::now();
         report.tolerance_factor = params.tolerance_factor(max_speed(&state.velocities));
-        (report.internal_iterations, report.internal_residual) =
-            self.internal_forces(cloth, state, params, report.tolerance_factor);
+        (
+            report.internal_iterations,
+            report.internal_residual,
+            report.internal_converged,
+        ) = self.internal_forces(cloth, state, params, report.tolerance_factor);
         guard_edges(Stage::InternalForces, "axial force", &self.s.p, time)?;
         report.timings.internal = t0.elapsed();
 
         // 3. Unconstrained velocity.
         let t0 = Instant::now();
-        self.unconstrained_velocity(cloth, state, params);
+        (report.bending_iterations, report.bending_residual) =
+            self.unconstrained_velocity(cloth, state, params);
         guard_nodes(Stage::Velocity, "velocity", &self.s.vel, time)?;
         report.timings.velocity = t0.elapsed();
 
@@ -178,24 +197,22 @@ impl Solver {
             &self.s.target,
             time,
         )?;
-        self.prepare_long_range(cloth, params);
-        let mut collision_time = Duration::ZERO;
-        self.s.pressure_time = Duration::ZERO;
-        for pass in 0..params.collision_passes {
-            let (iters, residual, cg) =
-                self.shape_iterations(cloth, state, params, report.tolerance_factor);
-            report.shape_iterations += iters;
-            report.cg_iterations += cg;
-            report.shape_residual = residual;
-            guard_nodes(Stage::ShapeConstraints, "velocity", &self.s.vel, time)?;
-            let tc = Instant::now();
-            self.collision_pass(cloth, state, dt, pass, hook);
-            collision_time += tc.elapsed();
-            guard_nodes(Stage::Collision, "velocity", &self.s.vel, time)?;
-        }
-        report.timings.collision = collision_time;
-        report.timings.pressure += self.s.pressure_time;
-        report.timings.shape = t0.elapsed() - collision_time - self.s.pressure_time;
+        self.cell_shear(cloth, state, params);
+        let pressure_before = report.timings.pressure;
+        self.shape_stage(
+            cloth,
+            state,
+            params,
+            report.tolerance_factor,
+            hook,
+            &mut report,
+        )?;
+        report.timings.shape = t0.elapsed()
+            - report.timings.collision
+            - (report.timings.pressure - pressure_before);
+        report.converged = report.shape_converged
+            && report.internal_converged
+            && report.bending_residual <= params.bending_tolerance;
 
         // 5. Update and commit.
         let t0 = Instant::now();

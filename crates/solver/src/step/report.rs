@@ -4,6 +4,7 @@
 use std::time::Duration;
 
 use super::V3;
+use super::projection::Constraint;
 use crate::cloth::Cloth;
 use crate::params::{ParamError, StepParams};
 use crate::state::ClothState;
@@ -56,6 +57,14 @@ pub enum StepError {
         strain: f64,
         /// The limit.
         limit: f64,
+        /// Simulated time at the start of the step.
+        time: f64,
+    },
+    /// The shape stage's linear algebra failed (a factorization that cannot be made).
+    #[error("the shape constraints cannot be solved at time {time} s: {message}")]
+    Solve {
+        /// What failed.
+        message: String,
         /// Simulated time at the start of the step.
         time: f64,
     },
@@ -113,17 +122,37 @@ impl StageTimings {
 /// Diagnostics of one step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepReport {
-    /// Internal-force iterations (axial phase, diagonal phase).
-    pub internal_iterations: [usize; 2],
-    /// Final E over its value at p = 0 (1 = nothing balanced, 0 = all external load carried).
-    pub internal_residual: f64,
+    /// Whether the step met every tolerance: the shape constraints (`shape_converged`), the
+    /// internal forces (`internal_converged`) and the implicit bending solve.
+    pub converged: bool,
+    /// Whether the largest relative violation the step ends with (after the last collision
+    /// pass), `violation`, is at most `shape_tolerance` (× the tolerance policy's factor).
+    pub shape_converged: bool,
+    /// The largest relative violation of the shape constraints the step ends with: |l − l̄|/l⁰
+    /// of the axial edges, the cells' compliant residual (rad), ties' excess and depth behind
+    /// contact planes over the node spacing.
+    pub violation: f64,
+    /// The constraint with that violation.
+    pub worst: Option<Constraint>,
+    /// The violation at the end of the last pass's iterations (before its collision pass).
+    pub shape_pass_violation: f64,
     /// Shape iterations over all passes.
     pub shape_iterations: usize,
-    /// Conjugate-gradient iterations over all passes (Newton shape method only).
-    pub cg_iterations: usize,
-    /// RMS of the per-node length error R after the last iteration, m.
-    pub shape_residual: f64,
-    /// Largest |ε − ε̄| over the edges after the update (stretch-only edges: excess only).
+    /// Numeric factorizations of the shape stage's system (direct method).
+    pub factorizations: usize,
+    /// Conjugate-gradient iterations of the shape stage (global methods).
+    pub linear_iterations: usize,
+    /// Internal-force iterations (axial edges).
+    pub internal_iterations: usize,
+    /// Final E over its value at p = 0 (1 = nothing balanced, 0 = all external load carried).
+    pub internal_residual: f64,
+    /// Whether the internal forces' projected gradient met `internal_tolerance`.
+    pub internal_converged: bool,
+    /// Iterations of the implicit bending solve.
+    pub bending_iterations: usize,
+    /// Its final residual relative to its initial one.
+    pub bending_residual: f64,
+    /// Largest |ε − ε̄| over the axial edges after the update (stretch-only edges: excess only).
     pub max_strain_error: f64,
     /// Kinetic energy after the step, J.
     pub kinetic_energy: f64,
@@ -158,6 +187,7 @@ pub(super) fn check_input(
             topo.cells().len(),
             state.shear_angle.len(),
         ),
+        ("cell shear states", topo.cells().len(), state.shear.len()),
     ] {
         if expected != found {
             return Err(StepError::Mismatch {

@@ -1,11 +1,10 @@
 //! The step's scratch buffers: sized once for a cloth, reused by every step after (no
 //! allocation per step once sized).
 
-use std::time::Duration;
-
 use atelier_grid::SLOTS;
 
 use super::par::resize;
+use super::projection::CellShear;
 use super::{Solver, Tie, V3};
 use crate::cloth::Cloth;
 
@@ -44,17 +43,12 @@ pub(super) struct Scratch {
     pub(super) grad: Vec<f64>,
     pub(super) force_per_width: Vec<f64>,
     pub(super) target: Vec<f64>,
+    /// Each cell's shear angle at the end of the step, rad.
     pub(super) shear: Vec<f64>,
-    /// Accumulated XPBD multipliers of compliant diagonals (reset each step).
-    pub(super) lambda_c: Vec<f64>,
+    /// Each cell's shear constraint of this step (empty: none).
+    pub(super) cell_shear: Vec<CellShear>,
     /// Contact planes set by the hooks this step.
     pub(super) planes: Vec<atelier_collide::ContactPlane>,
-    /// Nodes whose contact plane `project` applies (see `shape_iterations`).
-    pub(super) plane_nodes: Vec<u32>,
-    /// Nodes in a tie this step.
-    pub(super) tied: Vec<bool>,
-    /// Time spent in the pressure projections this step.
-    pub(super) pressure_time: Duration,
     /// The surface's reaction on the nodes lying on it (pressure stage only).
     pub(super) reaction: Vec<V3>,
     /// Node pairs held within a distance this step.
@@ -66,19 +60,8 @@ pub(super) struct Scratch {
     /// This step's largest target strain (the attachments' slack).
     pub(super) long_range_slack: f64,
     pub(super) vel: Vec<V3>,
-    pub(super) vel_prev: Vec<V3>,
-    pub(super) vel_hat: Vec<V3>,
     pub(super) pred: Vec<V3>,
-    pub(super) c: Vec<f64>,
-    pub(super) cdir: Vec<V3>,
-    pub(super) r: Vec<V3>,
     pub(super) chunk: Vec<f64>,
-    pub(super) cg_x: Vec<f64>,
-    pub(super) cg_r: Vec<f64>,
-    pub(super) cg_z: Vec<f64>,
-    pub(super) cg_p: Vec<f64>,
-    pub(super) cg_q: Vec<f64>,
-    pub(super) cg_y: Vec<V3>,
 }
 
 impl Solver {
@@ -101,10 +84,7 @@ impl Solver {
             &mut s.f_sum,
             &mut s.f_m,
             &mut s.vel,
-            &mut s.vel_prev,
-            &mut s.vel_hat,
             &mut s.pred,
-            &mut s.r,
         ] {
             resize(v, n, z);
         }
@@ -123,7 +103,6 @@ impl Solver {
         resize(&mut s.slot_coef, n, [0.0; SLOTS]);
         resize(&mut s.slot_len, n, [0.0; SLOTS]);
         resize(&mut s.dir, ne, z);
-        resize(&mut s.cdir, ne, z);
         for v in [
             &mut s.len,
             &mut s.p,
@@ -133,17 +112,9 @@ impl Solver {
             &mut s.grad,
             &mut s.force_per_width,
             &mut s.target,
-            &mut s.lambda_c,
-            &mut s.c,
-            &mut s.cg_x,
-            &mut s.cg_r,
-            &mut s.cg_z,
-            &mut s.cg_p,
-            &mut s.cg_q,
         ] {
             resize(v, ne, 0.0);
         }
-        resize(&mut s.cg_y, n, z);
         resize(&mut s.planes, n, atelier_collide::ContactPlane::default());
         resize(&mut s.shear, nc, 0.0);
         if self.external_forces.len() != n {

@@ -1,18 +1,21 @@
-//! Stage 4a: the shape constraints' target lengths, from the tensile characteristics (axial
-//! edges) and the shear characteristic (diagonals).
+//! Stage 4a: what the shape stage holds the cloth to in this step — the axial edges' target
+//! lengths from the tensile characteristics (thesis (25)), and each cell's shear constraint
+//! linearised about the start of the step from the fabric's shear loop (`method.md` §2b).
 
 use atelier_fabric::Branch;
 
 use super::Solver;
 use super::par::fill;
+use super::projection::CellShear;
 use crate::cloth::Cloth;
-use crate::params::{ConstraintKind, StepParams};
+use crate::params::StepParams;
+use crate::shear_angle::cell_angle;
 use crate::state::ClothState;
 
 impl Solver {
-    /// Target lengths: axial edges l⁰(1 + φ_θ(p/W)) through their hysteresis state (25); each
-    /// cell's diagonals from the cell's axial targets and its shear angle γ(τ),
-    /// τ = p₊/D₊ − p₋/D₋ (parallelogram geometry). Returns the number of extrapolated edges.
+    /// Target lengths of the axial edges, l⁰(1 + φ_θ(p/W)) through their hysteresis state (25)
+    /// (diagonals keep their rest length: they are not constrained); returns the number of
+    /// edges whose force lies beyond the measured range.
     pub(super) fn targets(
         &mut self,
         cloth: &Cloth,
@@ -51,39 +54,50 @@ impl Solver {
             };
             edge.rest_length * (1.0 + strain)
         });
-        let extrapolated = (0..edges.len())
+        (0..edges.len())
             .filter(|&e| edges[e].kind.is_axial() && !table.tensile(mats[e]).in_range(fpw[e]))
-            .count();
-        let shear_curve = cloth.shear_curve();
-        let cells = topo.cells();
-        let compliant = params.diagonal_constraint == ConstraintKind::Compliant;
-        fill(&mut s.shear, |c| {
-            if compliant {
-                // The spring carries the shear; the targets keep the rest angle.
-                return 0.0;
-            }
-            let cell = &cells[c];
-            let [dp, dm] = cell
-                .diagonals
-                .map(|d| p[d as usize] / edges[d as usize].rest_length);
-            shear_curve.angle(dp - dm)
-        });
-        for (c, cell) in cells.iter().enumerate() {
-            let mean =
-                |pair: [u32; 2], t: &[f64]| 0.5 * (t[pair[0] as usize] + t[pair[1] as usize]);
-            let (a, b) = (mean(cell.u_edges, &s.target), mean(cell.v_edges, &s.target));
-            let rest = |pair: [u32; 2]| {
-                0.5 * (edges[pair[0] as usize].rest_length + edges[pair[1] as usize].rest_length)
-            };
-            let (a0, b0) = (rest(cell.u_edges), rest(cell.v_edges));
-            let (alpha0, alpha) = (cell.rest_angle, cell.rest_angle - s.shear[c]);
-            for (k, sign) in [(0, 1.0), (1, -1.0)] {
-                let d = cell.diagonals[k] as usize;
-                let now = a * a + b * b + sign * 2.0 * a * b * alpha.cos();
-                let rest = a0 * a0 + b0 * b0 + sign * 2.0 * a0 * b0 * alpha0.cos();
-                s.target[d] = edges[d].rest_length * (now.max(0.0) / rest).sqrt();
-            }
+            .count()
+    }
+
+    /// Each cell's shear constraint for this step: the shear angle γ₀ at the start of the step
+    /// (by `params.shear_measure`), the loop's stress τ₀ and tangent k there (through the
+    /// cell's hysteresis state; the loop's centre line Gγ without hysteresis), times
+    /// `shear_scale`; the constraint γ − (γ₀ − τ₀/k) = 0 with compliance 1/(k·S). Nothing when
+    /// `shear_scale` is 0 (no shear rows at all).
+    pub(super) fn cell_shear(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
+        let cells = cloth.topology().cells();
+        if params.shear_scale == 0.0 {
+            self.s.cell_shear.clear();
+            return;
         }
-        extrapolated
+        self.s
+            .cell_shear
+            .resize(cells.len(), CellShear::default());
+        let rest = cloth.cell_rest_angles(params.shear_measure);
+        let (l, lock, scale) = (
+            cloth.shear_loop(),
+            cloth.locking_angle(),
+            params.shear_scale,
+        );
+        let hysteresis = params.hysteresis && l.is_hysteretic();
+        let l = l.clone().with_deadband(params.shear_deadband);
+        let (pos, states, measure) = (&state.positions, &state.shear, params.shear_measure);
+        fill(&mut self.s.cell_shear, |c| {
+            let cell = &cells[c];
+            let q = cell.nodes.map(|k| pos[k as usize]);
+            let gamma = rest[c] - cell_angle(measure, &q);
+            let (tau, k) = if hysteresis {
+                (states[c].stress(&l, gamma), states[c].tangent(&l, gamma))
+            } else {
+                (l.stiffness() * gamma, l.stiffness())
+            };
+            let (tau, k) = (tau * scale, k * scale);
+            CellShear {
+                rest: rest[c],
+                offset: gamma - tau / k,
+                compliance: 1.0 / (k * cell.area),
+                lock,
+            }
+        });
     }
 }

@@ -9,6 +9,7 @@ use super::bending::regularised;
 use super::par::fill;
 use crate::cloth::Cloth;
 use crate::params::{ConstraintKind, StepParams};
+use crate::shear_angle::cell_angle;
 use crate::state::ClothState;
 
 impl Solver {
@@ -64,12 +65,22 @@ impl Solver {
             *v = w + e;
         }
         state.axial_force.copy_from_slice(&self.s.p);
+        // The cells' shear angles at the end of the step, by the step's measure.
+        let (cells, rest, pos) = (
+            cloth.topology().cells(),
+            cloth.cell_rest_angles(params.shear_measure),
+            &state.positions,
+        );
+        fill(&mut self.s.shear, |c| {
+            let q = cells[c].nodes.map(|k| pos[k as usize]);
+            rest[c] - cell_angle(params.shear_measure, &q)
+        });
         state.shear_angle.copy_from_slice(&self.s.shear);
         self.commit_hysteresis(cloth, state, params);
         state.time += params.dt;
     }
 
-    /// Commit the hysteresis states at this step's forces and curvatures.
+    /// Commit the hysteresis states at this step's forces, curvatures and shear angles.
     fn commit_hysteresis(&mut self, cloth: &Cloth, state: &mut ClothState, params: &StepParams) {
         if !params.hysteresis {
             return;
@@ -82,6 +93,13 @@ impl Solver {
                 if edges[e].kind.is_axial() {
                     st.update(table.tensile(mats[e]), fpw[e]);
                 }
+            }
+        }
+        let shear = cloth.shear_loop();
+        if shear.is_hysteretic() && params.shear_scale > 0.0 {
+            let l = shear.clone().with_deadband(params.shear_deadband);
+            for (st, &gamma) in state.shear.iter_mut().zip(&self.s.shear) {
+                st.update(&l, gamma);
             }
         }
         if cloth.bending_hysteretic() && !params.bending_off {
@@ -102,7 +120,8 @@ impl Solver {
         }
     }
 
-    /// Largest |ε − ε̄| after the update (stretch-only edges count only excess stretch).
+    /// Largest |ε − ε̄| of the axial edges after the update (stretch-only edges count only
+    /// excess stretch).
     pub(super) fn max_strain_error(
         &self,
         cloth: &Cloth,
@@ -111,22 +130,16 @@ impl Solver {
     ) -> f64 {
         let edges = cloth.topology().edges();
         let pos = &state.positions;
-        edges
+        cloth
+            .axial_edge_list()
             .iter()
-            .enumerate()
-            .map(|(e, edge)| {
+            .map(|&e| {
+                let edge = &edges[e as usize];
                 let l = (pos[edge.b as usize] - pos[edge.a as usize]).norm();
-                let err = (l - self.s.target[e]) / edge.rest_length;
-                let kind = if edge.kind.is_axial() {
-                    params.axial_constraint
-                } else {
-                    params.diagonal_constraint
-                };
-                match kind {
+                let err = (l - self.s.target[e as usize]) / edge.rest_length;
+                match params.axial_constraint {
                     ConstraintKind::Equality => err.abs(),
                     ConstraintKind::StretchOnly => err.max(0.0),
-                    // A spring: its stretch is the shear, not an error.
-                    ConstraintKind::Compliant => 0.0,
                 }
             })
             .fold(0.0, f64::max)

@@ -11,13 +11,15 @@ use crate::state::ClothState;
 
 impl Solver {
     /// (18): ṙ⁰ = (μṙ + F^m Δt)/(μ + cΔt), with the bending stiffness k added implicitly along
-    /// the normal, (μ + cΔt + kΔt²). Pinned nodes take their prescribed velocity.
+    /// the normal, (μ + cΔt + kΔt²). Pinned nodes take their prescribed velocity. Returns the
+    /// implicit solve's iterations and its final residual relative to its initial one (0 and 0
+    /// when it did not run).
     pub(super) fn unconstrained_velocity(
         &mut self,
         cloth: &Cloth,
         state: &ClothState,
         params: &StepParams,
-    ) {
+    ) -> (usize, f64) {
         let dt = params.dt;
         let (mass, areas) = (cloth.masses(), cloth.topology().node_areas());
         let axial = cloth.topology().axial_neighbours();
@@ -39,13 +41,13 @@ impl Solver {
             s.vel[i] = (pin.position(t1) - pos[i]) / dt;
         }
         if !implicit {
-            return;
+            return (0, 0.0);
         }
         // Implicit bending along the normals, linearised (method §2: explicit bending limits Δt
         // to ~2√(μ/k), k ≈ 16WB/h³, which scales with h²). Unknowns: the normal speeds w of the
         // free nodes; (μ + cΔt) w − Δt² K w = (μ + cΔt) n·ṙ_explicit, K the bending stiffness
         // for normal displacements (the same stencil as the force, with B), solved by
-        // Jacobi-preconditioned CG. Statics are unchanged; rigid motions have K w = 0.
+        // Jacobi-preconditioned BiCGSTAB to `bending_tolerance`. Statics are unchanged; rigid motions have K w = 0.
         let k_apply = |w: &[f64],
                        dm: &mut [f64],
                        out: &mut [f64],
@@ -95,15 +97,15 @@ impl Solver {
         // rhs b = (μ + cΔt) w_explicit for free nodes; pinned w stay prescribed (moved to b).
         k_apply(&s.w, &mut s.w_dm, &mut s.w_ap, &s.slot_coef, &s.slot_len);
         for i in 0..s.w.len() {
-            let (mu, c) = (mass[i], params.damping * areas[i]);
             // r = b − A w with w = w_explicit: r = Δt² K w (free nodes).
             s.w_r[i] = if free(i) { dt * dt * s.w_ap[i] } else { 0.0 };
-            let _ = (mu, c);
         }
         // The stencil is not exactly symmetric at free edges and clamps (the thesis's force is
         // not the gradient of an energy), so the solve is Jacobi-preconditioned BiCGSTAB.
         let n = s.w.len();
         let r0: f64 = s.w_r.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let (tol, cap) = (params.bending_tolerance * r0, params.bending_max_iterations);
+        let (mut iterations, mut residual) = (0, 0.0);
         if r0 > 0.0 {
             let apply_a = |x: &[f64],
                            dm: &mut [f64],
@@ -136,7 +138,9 @@ impl Solver {
             let mut alpha = 1.0;
             let mut omega = 1.0;
             s.w_p.iter_mut().for_each(|x| *x = 0.0);
-            for _ in 0..10 {
+            residual = r0;
+            while iterations < cap {
+                iterations += 1;
                 let rho_new = dot(&r_hat, &s.w_r);
                 if rho_new == 0.0 || omega == 0.0 {
                     break;
@@ -157,7 +161,8 @@ impl Solver {
                     s.w[i] += alpha * y[i];
                     s.w_r[i] -= alpha * v[i];
                 }
-                if dot(&s.w_r, &s.w_r).sqrt() <= 1e-4 * r0 {
+                residual = dot(&s.w_r, &s.w_r).sqrt();
+                if residual <= tol {
                     break;
                 }
                 for (i, zi) in z.iter_mut().enumerate() {
@@ -170,7 +175,8 @@ impl Solver {
                     s.w[i] += omega * z[i];
                     s.w_r[i] -= omega * t[i];
                 }
-                if dot(&s.w_r, &s.w_r).sqrt() <= 1e-4 * r0 {
+                residual = dot(&s.w_r, &s.w_r).sqrt();
+                if residual <= tol {
                     break;
                 }
             }
@@ -187,5 +193,6 @@ impl Solver {
                 *v += n * (w[i] - n.dot(v));
             }
         }
+        (iterations, if r0 > 0.0 { residual / r0 } else { 0.0 })
     }
 }

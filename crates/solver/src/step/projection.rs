@@ -26,14 +26,22 @@ use rayon::prelude::*;
 
 use crate::cloth::Cloth;
 use crate::dual::{DualError, DualSystem, NONE, NodeWeight, Preconditioner, SLOTS};
-use crate::params::ConstraintKind;
+use crate::params::{ConstraintKind, ShapeMethod};
 use crate::shear_angle::{ShearMeasure, cell_angle_gradient};
-use crate::step::{Tie, plane_push};
+use super::{Tie, plane_push};
 
 type V3 = Vector3<f64>;
 
 /// Below this many rows, loops run on one thread.
 const PAR_MIN: usize = 2048;
+
+/// Relative residual of each Newton step's linear solve (an inexact Newton step: the outer
+/// iteration measures the constraints themselves).
+const LINEAR_TOLERANCE: f64 = 1e-3;
+
+/// CG iterations per Newton step with the factorization as preconditioner (a stale one that
+/// needs this many is renewed before the next step).
+const LINEAR_CAP: usize = 50;
 
 /// Relative regularisation of hard rows (a compliance this small against the row's own
 /// stiffness changes a converged length by ~1e-12 of the correction).
@@ -76,39 +84,17 @@ pub struct ShapeProblem<'a> {
     pub planes: &'a [ContactPlane],
 }
 
-/// How the shape stage iterates (see the module doc).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Iteration {
-    /// Newton on the constraint-space system, solved with the LDLᵀ factorization as CG
-    /// preconditioner; the factorization is renewed when a solve needs more than
-    /// `refactor_after` CG iterations.
-    Direct {
-        /// CG iterations above which the factorization is renewed.
-        refactor_after: usize,
-    },
-    /// Newton with Jacobi-preconditioned CG (no factorization), up to `cg_iterations` per
-    /// Newton step.
-    ConjugateGradient {
-        /// CG iterations per Newton step (cap).
-        cg_iterations: usize,
-    },
-    /// Local: each row corrected by its own diagonal, scaled by its nodes' row counts.
-    Jacobi {
-        /// Step γ in (0, 1].
-        step: f64,
-    },
-    /// Jacobi with Chebyshev semi-iterative acceleration (Wang 2015).
-    Chebyshev {
-        /// Step γ in (0, 1].
-        step: f64,
-        /// Spectral radius estimate in (0, 1).
-        rho: f64,
-    },
-    /// Local: rows in colours sharing no node, each row solved exactly, over-relaxed.
-    GaussSeidel {
-        /// Over-relaxation in (0, 2).
-        omega: f64,
-    },
+/// A constraint of the shape stage, for reports: which one was violated most.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Constraint {
+    /// An axial edge's length (edge index).
+    Edge(usize),
+    /// A cell's shear (cell index).
+    Cell(usize),
+    /// A tie being drawn together (index in the step's ties).
+    Tie(usize),
+    /// A node's contact plane (node index).
+    Plane(usize),
 }
 
 /// What one call of [`ShapeSolver::solve`] did.
@@ -124,8 +110,8 @@ pub struct ShapeReport {
     pub factorizations: usize,
     /// Conjugate-gradient iterations.
     pub linear_iterations: usize,
-    /// The row with the largest violation: 0 edge, 1 cell, 2 tie, 3 plane (node); and its index.
-    pub worst: (u8, usize),
+    /// The constraint with the largest violation (None when nothing is violated).
+    pub worst: Option<Constraint>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -193,11 +179,6 @@ fn find(root: &mut [u32], mut i: u32) -> u32 {
 }
 
 impl ShapeSolver {
-    /// An empty solver (the system is built on first use).
-    pub fn new() -> Self {
-        Self::default()
-    }
-
     /// Group the nodes tied at length 0, list the open ties, (re)build the rows when they changed,
     /// and reset the multipliers (XPBD: once per step).
     fn prepare(&mut self, p: &ShapeProblem<'_>) -> Result<(), DualError> {
@@ -422,7 +403,7 @@ impl ShapeSolver {
     /// Evaluate every row at the predicted positions: constraint values, gradients (into the
     /// system), diagonal extras, right-hand sides and violations. Returns the largest violation
     /// and its row.
-    fn evaluate(&mut self, p: &ShapeProblem<'_>, vel: &[V3]) -> (f64, (u8, usize)) {
+    fn evaluate(&mut self, p: &ShapeProblem<'_>, vel: &[V3]) -> (f64, Option<Constraint>) {
         let st = self.structure.as_mut().expect("prepared");
         let (x0, dt) = (p.positions, p.dt);
         for (x, (a, v)) in self.pred.iter_mut().zip(x0.iter().zip(vel)) {
@@ -542,15 +523,15 @@ impl ShapeSolver {
                 .enumerate()
                 .for_each(row);
         }
-        let mut worst = (0.0, (0u8, 0usize));
+        let mut worst = (0.0, None);
         for (r, &v) in self.viol.iter().enumerate() {
             if v > worst.0 {
-                let kind = match st.kinds[r] {
-                    RowKind::Edge(e) => (0, e as usize),
-                    RowKind::Cell(c) => (1, c as usize),
-                    RowKind::Tie(t) => (2, self.open_tie_index[t as usize] as usize),
+                let which = match st.kinds[r] {
+                    RowKind::Edge(e) => Constraint::Edge(e as usize),
+                    RowKind::Cell(c) => Constraint::Cell(c as usize),
+                    RowKind::Tie(t) => Constraint::Tie(self.open_tie_index[t as usize] as usize),
                 };
-                worst = (v, kind);
+                worst = (v, Some(which));
             }
         }
         // Planes: penetration over the spacing.
@@ -559,7 +540,7 @@ impl ShapeSolver {
                 let d = (self.pred[i] - plane.point).dot(&plane.normal);
                 let v = (-d).max(0.0) / spacing[i];
                 if v > worst.0 {
-                    worst = (v, (3, i));
+                    worst = (v, Some(Constraint::Plane(i)));
                 }
             }
         }
@@ -615,18 +596,21 @@ impl ShapeSolver {
     }
 
     /// Correct `vel` until the largest violation is at most `tol` or `max_iterations`
-    /// corrections were made; `after` runs after every correction (the pressure stage's volume
-    /// constraint). The multipliers are reset when `first_pass` (once per step).
+    /// corrections were made; `after` runs after every correction, before the hard
+    /// constraints are projected again (the pressure stage's volume constraint, the long-range
+    /// attachments). The rows are (re)built and the multipliers reset when `first_pass` (once
+    /// per step). `step` is the Jacobi and Chebyshev γ.
     #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &mut self,
         p: &ShapeProblem<'_>,
         vel: &mut [V3],
-        method: Iteration,
+        method: ShapeMethod,
+        step: f64,
         tol: f64,
         max_iterations: usize,
         first_pass: bool,
-        after: &mut dyn FnMut(usize, &mut [V3]),
+        after: &mut dyn FnMut(&mut [V3]),
     ) -> Result<ShapeReport, DualError> {
         if first_pass || self.structure.is_none() {
             self.prepare(p)?;
@@ -648,7 +632,7 @@ impl ShapeSolver {
             let k = report.iterations;
             report.iterations += 1;
             match method {
-                Iteration::Direct { refactor_after } => {
+                ShapeMethod::Direct { refactor_after } => {
                     let st = self.structure.as_mut().expect("prepared");
                     if self.last_cg > refactor_after || !st.system.is_factored() {
                         st.system.factorize(Par::Seq)?;
@@ -657,8 +641,8 @@ impl ShapeSolver {
                     let stats = st.system.solve(
                         &self.b,
                         &mut self.dl,
-                        1e-3,
-                        50,
+                        LINEAR_TOLERANCE,
+                        LINEAR_CAP,
                         Preconditioner::Factor,
                         Par::Seq,
                     )?;
@@ -666,12 +650,12 @@ impl ShapeSolver {
                     report.linear_iterations += stats.iterations;
                     self.apply(p, vel);
                 }
-                Iteration::ConjugateGradient { cg_iterations } => {
+                ShapeMethod::ConjugateGradient { cg_iterations } => {
                     let st = self.structure.as_mut().expect("prepared");
                     let stats = st.system.solve(
                         &self.b,
                         &mut self.dl,
-                        1e-3,
+                        LINEAR_TOLERANCE,
                         cg_iterations,
                         Preconditioner::Diagonal,
                         Par::Seq,
@@ -679,11 +663,11 @@ impl ShapeSolver {
                     report.linear_iterations += stats.iterations;
                     self.apply(p, vel);
                 }
-                Iteration::Jacobi { step } => {
+                ShapeMethod::Jacobi => {
                     self.jacobi(step);
                     self.apply(p, vel);
                 }
-                Iteration::Chebyshev { step, rho } => {
+                ShapeMethod::Chebyshev { rho } => {
                     omega = match k {
                         0 => 1.0,
                         1 => 2.0 / (2.0 - rho * rho),
@@ -706,12 +690,21 @@ impl ShapeSolver {
                     std::mem::swap(&mut self.prev, &mut self.hat);
                     std::mem::swap(&mut self.lambda_prev, &mut self.lambda_hat);
                 }
-                Iteration::GaussSeidel { omega } => self.gauss_seidel(p, vel, omega),
+                ShapeMethod::GaussSeidel { omega } => self.gauss_seidel(p, vel, omega),
             }
+            after(vel);
             self.project(p, vel);
-            after(report.iterations, vel);
         }
         Ok(report)
+    }
+
+    /// The largest violation at `vel` and where it is, without correcting anything (after the
+    /// collision passes: what the step ends with).
+    pub fn measure(&mut self, p: &ShapeProblem<'_>, vel: &[V3]) -> (f64, Option<Constraint>) {
+        if self.structure.is_none() {
+            return (0.0, None);
+        }
+        self.evaluate(p, vel)
     }
 
     /// Δλ_r = s_r b_r / D_r (the local scaling of the Jacobi methods).
@@ -844,7 +837,7 @@ mod tests {
         cloth: &Cloth,
         state: &ClothState,
         vel: &mut [V3],
-        method: Iteration,
+        method: ShapeMethod,
         shear: bool,
         tol: f64,
         cap: usize,
@@ -883,9 +876,9 @@ mod tests {
             ties: &[],
             planes: &planes,
         };
-        let mut solver = ShapeSolver::new();
+        let mut solver = ShapeSolver::default();
         solver
-            .solve(&problem, vel, method, tol, cap, true, &mut |_, _| {})
+            .solve(&problem, vel, method, 1.0, tol, cap, true, &mut |_| {})
             .expect("solve")
     }
 
@@ -901,7 +894,7 @@ mod tests {
                 &cloth,
                 &state,
                 &mut vel,
-                Iteration::Direct { refactor_after: 3 },
+                ShapeMethod::Direct { refactor_after: 3 },
                 shear,
                 1e-8,
                 20,
@@ -929,7 +922,7 @@ mod tests {
                 &cloth,
                 &state,
                 &mut vel,
-                Iteration::ConjugateGradient { cg_iterations: 400 },
+                ShapeMethod::ConjugateGradient { cg_iterations: 400 },
                 shear,
                 1e-8,
                 40,
@@ -941,7 +934,7 @@ mod tests {
                 &cloth,
                 &state,
                 &mut vel,
-                Iteration::Jacobi { step: 1.0 },
+                ShapeMethod::Jacobi,
                 shear,
                 1e-8,
                 0,
@@ -951,10 +944,7 @@ mod tests {
                 &cloth,
                 &state,
                 &mut vel,
-                Iteration::Chebyshev {
-                    step: 1.0,
-                    rho: 0.9,
-                },
+                ShapeMethod::Chebyshev { rho: 0.9 },
                 shear,
                 1e-8,
                 50,
