@@ -1,12 +1,14 @@
 //! Figures of the fabric model (issue 2): the tensile major loop with minor loops (thesis
 //! Fig. 11), the bending loop with initial and reversal curves (Fig. 13), and polar plots of the
-//! interpolated tensile and bending characteristics at 11.25° steps in both forms (Figs. 16–18).
+//! interpolated tensile and bending characteristics at 11.25° steps in both forms (Figs. 16–18),
+//! and the KES-FB1 shear loop with its initial, reversal and minor-loop curves (issue 21).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use atelier_fabric::{
-    AnisotropyForm, BendingState, Branch, Fabric, Spindle, TensileLoop, TensileState, units,
+    AnisotropyForm, BendingState, Branch, Fabric, ShearLoop, ShearState, Spindle, TensileLoop,
+    TensileState, units,
 };
 use plotters::prelude::*;
 
@@ -36,6 +38,11 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
             &cotton.bending.warp,
             &cotton.name,
             &out.join("bending_loop.png"),
+        )?,
+        shear_loop(
+            &cotton.shear_loop()?,
+            &cotton.name,
+            &out.join("shear_loop.png"),
         )?,
     ];
     for name in FIXTURES {
@@ -186,6 +193,194 @@ fn bending_loop(s: &Spindle, name: &str, path: &Path) -> Result<PathBuf> {
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperLeft)
             .label_font(("sans-serif", 15))
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .draw()?;
+        Ok(())
+    })
+}
+
+/// Follow a shear-angle path (degrees, turning points) through the shear loop from rest, with
+/// `per_deg` samples per degree: (°, gf/cm).
+fn shear_path(l: &ShearLoop, turns: &[f64], per_deg: f64) -> Vec<(f64, f64)> {
+    let mut st = ShearState::VIRGIN;
+    let mut pts = vec![(0.0, 0.0)];
+    let mut from = 0.0;
+    for &to in turns {
+        let n = ((to - from).abs() * per_deg).ceil().max(1.0) as usize;
+        for i in 1..=n {
+            let g = from + (to - from) * i as f64 / n as f64;
+            let tau = st.update(l, g.to_radians());
+            pts.push((g, units::force_to_kes(tau)));
+        }
+        from = to;
+    }
+    pts
+}
+
+/// The KES-FB1 shear loop of one fabric: left, the cycle 0 → +8° → −8° → +8° with the branches
+/// and the measuring angles, and minor loops; right, the small angles enlarged (the initial
+/// curve's finite slope 3G, a reversal inside the loop).
+fn shear_loop(l: &ShearLoop, name: &str, path: &Path) -> Result<PathBuf> {
+    let g = units::shear_stiffness_to_kes(l.stiffness());
+    let (hg, hg5) = (
+        units::force_to_kes(l.half_width(0.0)),
+        units::force_to_kes(l.half_width(8f64.to_radians())),
+    );
+    let join = l.join_angle().to_degrees();
+    let s0 = units::shear_stiffness_to_kes(l.initial_slope());
+    let kes = shear_path(l, &[8.0, -8.0, 8.0], 12.0);
+    let t_max = kes.iter().map(|p| p.1.abs()).fold(0.0, f64::max) * 1.08;
+    let grey = RGBColor(150, 150, 150);
+    png(path, (1600, 800), |root| {
+        let (title, body) = root.split_vertically(64);
+        title.draw(&Text::new(
+            format!("Shear hysteresis (KES-FB1 loop), {name}"),
+            (20, 8),
+            ("sans-serif", 22).into_font(),
+        ))?;
+        title.draw(&Text::new(
+            format!(
+                "G = {g:.2} gf/(cm·deg), 2HG = {:.2} gf/cm, 2HG5 = {:.2} gf/cm; join angle \
+                 Δj = 2HG/G = {join:.2}°; initial slope {s0:.2} gf/(cm·deg) = 3G",
+                2.0 * hg,
+                2.0 * hg5
+            ),
+            (20, 36),
+            ("sans-serif", 18).into_font(),
+        ))?;
+        let (left, right) = body.split_horizontally(1000);
+        // Left: the whole loop.
+        let mut chart = ChartBuilder::on(&left)
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(-9.0..9.0, -t_max..t_max)?;
+        chart
+            .configure_mesh()
+            .x_desc("shear angle γ (°)")
+            .y_desc("shear force per width τ (gf/cm)")
+            .axis_desc_style(("sans-serif", 18))
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        for x in [-5.0, -0.5, 0.5, 5.0] {
+            chart.draw_series(DashedLineSeries::new(
+                vec![(x, -t_max), (x, t_max)],
+                3,
+                5,
+                grey.mix(0.6).stroke_width(1),
+            ))?;
+        }
+        let branch = |sign: f64| -> Vec<(f64, f64)> {
+            (0..=180)
+                .map(|i| {
+                    let x = -9.0 + 18.0 * i as f64 / 180.0;
+                    let r = x.to_radians();
+                    let tau = if sign > 0.0 { l.upper(r) } else { l.lower(r) };
+                    (x, units::force_to_kes(tau))
+                })
+                .collect()
+        };
+        for sign in [1.0, -1.0] {
+            chart.draw_series(DashedLineSeries::new(
+                branch(sign),
+                8,
+                6,
+                grey.stroke_width(2),
+            ))?;
+        }
+        chart
+            .draw_series(std::iter::once(PathElement::new(vec![(0.0, 0.0)], grey)))?
+            .label("branches τ = Gγ ± h(|γ|) (h: HG to 0.5°, HG5 from 5°); dotted: ±0.5°, ±5°")
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], grey.stroke_width(2))
+            });
+        chart
+            .draw_series(LineSeries::new(kes.clone(), BLACK.stroke_width(3)))?
+            .label("KES cycle 0 → +8° → −8° → +8°")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(3)));
+        let paths: [(&[f64], &str); 3] = [
+            (&[6.0, 1.5, 7.0], "0 → 6° → 1.5° → 7°"),
+            (&[-4.0, -1.0, -3.0, 2.5], "0 → −4° → −1° → −3° → 2.5°"),
+            (
+                &[3.0, 2.2, 3.5, -6.0],
+                "0 → 3° → 2.2° → 3.5° → −6° (inside the loop)",
+            ),
+        ];
+        for (k, (turns, label)) in paths.into_iter().enumerate() {
+            let c = PALETTE[k];
+            chart
+                .draw_series(LineSeries::new(
+                    shear_path(l, turns, 12.0),
+                    c.stroke_width(2),
+                ))?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font(("sans-serif", 15))
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .draw()?;
+        // Right: small angles.
+        let (x_max, y_max) = (2.0, units::force_to_kes(l.upper(2f64.to_radians())) * 1.15);
+        let mut zoom = ChartBuilder::on(&right)
+            .caption("small angles", ("sans-serif", 18))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(60)
+            .build_cartesian_2d(-x_max..x_max, -y_max..y_max)?;
+        zoom.configure_mesh()
+            .x_desc("shear angle γ (°)")
+            .y_desc("τ (gf/cm)")
+            .axis_desc_style(("sans-serif", 18))
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        let narrow = |sign: f64| -> Vec<(f64, f64)> {
+            (0..=80)
+                .map(|i| {
+                    let x = -x_max + 2.0 * x_max * i as f64 / 80.0;
+                    let r = x.to_radians();
+                    let tau = if sign > 0.0 { l.upper(r) } else { l.lower(r) };
+                    (x, units::force_to_kes(tau))
+                })
+                .collect()
+        };
+        for sign in [1.0, -1.0] {
+            zoom.draw_series(DashedLineSeries::new(
+                narrow(sign),
+                8,
+                6,
+                grey.stroke_width(2),
+            ))?;
+        }
+        let tangent = vec![(-0.6, -0.6 * s0), (0.6, 0.6 * s0)];
+        let amber = PALETTE[4];
+        zoom.draw_series(DashedLineSeries::new(tangent, 6, 4, amber.stroke_width(2)))?
+            .label(format!("slope at rest {s0:.2} gf/(cm·deg) = 3G"))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], amber.stroke_width(2))
+            });
+        zoom.draw_series(LineSeries::new(
+            shear_path(l, &[1.6, -1.6, 1.6], 40.0),
+            BLACK.stroke_width(3),
+        ))?
+        .label("0 → 1.6° → −1.6° → 1.6°")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(3)));
+        let c = PALETTE[5];
+        zoom.draw_series(LineSeries::new(
+            shear_path(l, &[0.4, -0.3, 0.6], 80.0),
+            c.stroke_width(2),
+        ))?
+        .label("0 → 0.4° → −0.3° → 0.6°")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(2)));
+        zoom.configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font(("sans-serif", 14))
             .background_style(WHITE.mix(0.9))
             .border_style(BLACK)
             .draw()?;

@@ -26,14 +26,17 @@ pub const STANDARD_GRAVITY: f64 = 9.80665;
 /// measurement (set `locking_angle_deg` in the fabric file when it is known).
 pub const DEFAULT_LOCKING_ANGLE: f64 = 40.0 * std::f64::consts::PI / 180.0;
 
-/// KES shear values in SI, with the locking angle that bounds the trellis shear.
+/// KES shear values in SI (as the file gives them, or fitted to its measured loop), with the
+/// locking angle that bounds the trellis shear of the derived bias loop. [`Shear::to_loop`] is
+/// the angle-driven loop the cloth step uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shear {
     /// Shear stiffness G, N/(m·rad).
     pub stiffness: f64,
     /// Hysteresis width 2HG at 0.5°, N/m.
     pub hysteresis: f64,
-    /// Hysteresis width 2HG5 at 5°, N/m (reports only).
+    /// Hysteresis width 2HG5 at 5°, N/m: the shear loop's width from 5° on (the derived bias loop
+    /// uses 2HG only).
     pub hysteresis_5deg: Option<f64>,
     /// Locking angle γ_lock, rad, in (0, π/2).
     pub locking_angle: f64,
@@ -137,7 +140,7 @@ pub struct Fabric {
     pub tensile: Directions<TensileLoop>,
     /// Bending characteristics in the measured directions (bias ones measured or derived).
     pub bending: Directions<Spindle>,
-    /// KES shear values, if given.
+    /// KES shear values, if the file has a shear section (given, or fitted to a measured loop).
     pub shear: Option<Shear>,
 }
 

@@ -509,3 +509,35 @@ fn fabric_specs_round_trip_through_ron() {
         assert_eq!(back, spec, "{written}");
     }
 }
+
+/// The measured shear loop example of docs/fabric.md §7 parses (put into the complete example
+/// in place of its KES shear values) and gives the values the text states.
+#[test]
+fn the_documented_measured_shear_loop_parses() {
+    let doc = std::fs::read_to_string(root().join("docs/fabric.md")).expect("docs/fabric.md");
+    let block = |from: usize| {
+        let start = from + doc[from..].find("```ron\n").expect("a ```ron block") + "```ron\n".len();
+        let len = doc[start..].find("```").expect("closed block");
+        (start, &doc[start..start + len])
+    };
+    let (first_end, example) = block(0);
+    let (_, shear) = block(first_end);
+    let line = example
+        .lines()
+        .find(|l| l.trim_start().starts_with("shear:"))
+        .expect("the example's shear line");
+    let text = example.replacen(line, shear.trim_end(), 1);
+    let f = Fabric::from_ron_str(&text, Path::new("docs/fabric.md")).expect("example parses");
+    let s = f.shear.expect("shear");
+    assert_relative_eq!(
+        units::shear_stiffness_to_kes(s.stiffness),
+        1.2,
+        max_relative = 0.01
+    );
+    assert_relative_eq!(units::force_to_kes(s.hysteresis), 2.0, max_relative = 0.01);
+    assert_relative_eq!(
+        units::force_to_kes(s.hysteresis_5deg.expect("2HG5")),
+        3.6,
+        max_relative = 0.01
+    );
+}
