@@ -180,7 +180,7 @@ impl Fixture {
             self.side,
             r.max_strain_error
         );
-        assert!(r.shape_residual.is_finite() && r.internal_residual.is_finite());
+        assert!(r.violation.is_finite() && r.internal_residual.is_finite());
         assert!(
             r.max_speed > 0.05,
             "{}² sheet: not moving ({} m/s)",
@@ -199,7 +199,7 @@ struct StageMedians {
     steps: usize,
     timings: StageTimings,
     total: Duration,
-    internal_iterations: [f64; 2],
+    internal_iterations: f64,
     shape_iterations: f64,
     /// Median over the steps of shape time / (edges × shape iterations), ns.
     ns_per_edge_shape_iteration: f64,
@@ -264,14 +264,12 @@ fn stage_medians(fixture: &Fixture, steps: usize) -> StageMedians {
             pressure: median_duration(&reports, |t| t.pressure),
         },
         total: median_duration(&reports, |t| t.total()),
-        internal_iterations: [0, 1].map(|k| {
-            median_f64(
-                reports
-                    .iter()
-                    .map(|r| r.internal_iterations[k] as f64)
-                    .collect(),
-            )
-        }),
+        internal_iterations: median_f64(
+            reports
+                .iter()
+                .map(|r| r.internal_iterations as f64)
+                .collect(),
+        ),
         shape_iterations: median_f64(reports.iter().map(|r| r.shape_iterations as f64).collect()),
         ns_per_edge_shape_iteration: median_f64(
             reports
@@ -283,10 +281,7 @@ fn stage_medians(fixture: &Fixture, steps: usize) -> StageMedians {
             reports
                 .iter()
                 .map(|r| {
-                    per_edge_iteration(
-                        r.timings.internal,
-                        r.internal_iterations[0] + r.internal_iterations[1],
-                    )
+                    per_edge_iteration(r.timings.internal, r.internal_iterations)
                 })
                 .collect(),
         ),
@@ -307,7 +302,7 @@ impl StageMedians {
     fn row(&self) -> String {
         let t = &self.timings;
         format!(
-            "| {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {:.0}+{:.0} | {:.0} | {:.2} | {:.2} | {:.1e} |\n",
+            "| {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.2} | {:.2} | {:.1e} |\n",
             self.nodes,
             self.edges,
             self.steps,
@@ -319,8 +314,7 @@ impl StageMedians {
             ms(t.shape),
             ms(t.collision),
             ms(t.update),
-            self.internal_iterations[0],
-            self.internal_iterations[1],
+            self.internal_iterations,
             self.shape_iterations,
             self.ns_per_edge_shape_iteration,
             self.ns_per_edge_internal_iteration,

@@ -330,8 +330,13 @@ pub struct DrapeRun {
     pub max_strain_error: f64,
     /// Mean shape iterations per step.
     pub mean_shape_iterations: f64,
-    /// Steps that hit the shape iteration cap (the residual stayed above ε^e).
-    pub capped_steps: usize,
+    /// Steps that did not meet their tolerances (`StepReport::converged` false).
+    pub unconverged_steps: usize,
+    /// Steps whose shape constraints ended above `shape_tolerance` (after the last collision
+    /// pass).
+    pub shape_unconverged_steps: usize,
+    /// Largest violation any step ended with.
+    pub max_violation: f64,
     /// History every `sample_interval` (the last entry is the end).
     pub trace: Vec<DrapeSample>,
 }
@@ -377,8 +382,8 @@ pub fn run_drape(
     let mut settled = false;
     let mut max_strain_error: f64 = 0.0;
     let mut shape_iterations = 0usize;
-    let mut capped_steps = 0;
-    let cap = params.shape_max_iterations * params.collision_passes;
+    let (mut unconverged_steps, mut shape_unconverged_steps) = (0, 0);
+    let mut max_violation: f64 = 0.0;
     let mut trace = Vec::new();
     let mut next_sample = stop.sample_interval;
     let eps = 1e-9 * params.dt;
@@ -399,9 +404,9 @@ pub fn run_drape(
         steps += 1;
         max_strain_error = max_strain_error.max(report.max_strain_error);
         shape_iterations += report.shape_iterations;
-        if report.shape_iterations >= cap {
-            capped_steps += 1;
-        }
+        unconverged_steps += usize::from(!report.converged);
+        shape_unconverged_steps += usize::from(!report.shape_converged);
+        max_violation = max_violation.max(report.violation);
         if stop.sample_interval > 0.0 && state.time >= next_sample - eps {
             trace.push(sample(state));
             next_sample += stop.sample_interval;
@@ -431,7 +436,9 @@ pub fn run_drape(
         max_diagonal_strain: max_strain(cloth, state, false),
         max_strain_error,
         mean_shape_iterations: shape_iterations as f64 / steps.max(1) as f64,
-        capped_steps,
+        unconverged_steps,
+        shape_unconverged_steps,
+        max_violation,
         trace,
     })
 }

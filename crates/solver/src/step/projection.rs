@@ -43,6 +43,13 @@ const LINEAR_TOLERANCE: f64 = 1e-3;
 /// needs this many is renewed before the next step).
 const LINEAR_CAP: usize = 50;
 
+/// The largest move of a node in one Newton step, as a fraction of its spacing (a trust
+/// region against the huge steps of a nearly singular system).
+const MAX_MOVE: f64 = 0.5;
+
+/// Backtracking halvings of a Newton step before it is taken as it is.
+const LINE_SEARCH_HALVINGS: usize = 6;
+
 /// Relative regularisation of hard rows (a compliance this small against the row's own
 /// stiffness changes a converged length by ~1e-12 of the correction).
 const HARD_REGULARISATION: f64 = 1e-12;
@@ -110,6 +117,8 @@ pub struct ShapeReport {
     pub factorizations: usize,
     /// Conjugate-gradient iterations.
     pub linear_iterations: usize,
+    /// Halvings of Newton steps by the line search.
+    pub backtracks: usize,
     /// The constraint with the largest violation (None when nothing is violated).
     pub worst: Option<Constraint>,
 }
@@ -164,6 +173,9 @@ pub struct ShapeSolver {
     hat: Vec<V3>,
     lambda_prev: Vec<f64>,
     lambda_hat: Vec<f64>,
+    saved_vel: Vec<V3>,
+    /// Σ violation² of the last evaluation (the line search's merit).
+    merit: f64,
     last_cg: usize,
     /// Symbolic analyses made (diagnostics).
     pub analyses: usize,
@@ -280,7 +292,12 @@ impl ShapeSolver {
             v.clear();
             v.resize(rows, 0.0);
         }
-        for v in [&mut self.pred, &mut self.prev, &mut self.hat] {
+        for v in [
+            &mut self.pred,
+            &mut self.prev,
+            &mut self.hat,
+            &mut self.saved_vel,
+        ] {
             v.clear();
             v.resize(n, V3::zeros());
         }
@@ -524,7 +541,9 @@ impl ShapeSolver {
                 .for_each(row);
         }
         let mut worst = (0.0, None);
+        let mut merit = 0.0;
         for (r, &v) in self.viol.iter().enumerate() {
+            merit += v * v;
             if v > worst.0 {
                 let which = match st.kinds[r] {
                     RowKind::Edge(e) => Constraint::Edge(e as usize),
@@ -539,23 +558,39 @@ impl ShapeSolver {
             if plane.normal != V3::zeros() {
                 let d = (self.pred[i] - plane.point).dot(&plane.normal);
                 let v = (-d).max(0.0) / spacing[i];
+                merit += v * v;
                 if v > worst.0 {
                     worst = (v, Some(Constraint::Plane(i)));
                 }
             }
         }
+        self.merit = merit;
         worst
     }
 
-    /// Apply the correction Δx = W Jᵀ Δλ (per root) to every member's velocity, and add Δλ to
-    /// the multipliers (inequality rows kept ≤ 0).
-    fn apply(&mut self, p: &ShapeProblem<'_>, vel: &mut [V3]) {
+    /// Apply `scale` times the correction Δx = W Jᵀ Δλ (per root) to every member's velocity,
+    /// and add `scale`·Δλ to the multipliers (inequality rows kept ≤ 0). With `trust`, the scale
+    /// is reduced so that no node moves by more than [`MAX_MOVE`] of its spacing (a Newton step
+    /// from a nearly singular system can be huge).
+    fn apply(&mut self, p: &ShapeProblem<'_>, vel: &mut [V3], scale: f64, trust: bool) {
         let st = self.structure.as_mut().expect("prepared");
         let dx = st.system.correction(&self.dl);
         let dt = p.dt;
         let root = &self.root;
+        let mut scale = scale;
+        if trust {
+            let spacing = &self.spacing;
+            let ratio = dx
+                .iter()
+                .zip(spacing)
+                .map(|(d, h)| d.norm() / h)
+                .fold(0.0, f64::max);
+            if ratio * scale > MAX_MOVE {
+                scale = MAX_MOVE / ratio;
+            }
+        }
         let body = |(i, v): (usize, &mut V3)| {
-            *v += dx[root[i] as usize] / dt;
+            *v += dx[root[i] as usize] * (scale / dt);
         };
         if vel.len() >= PAR_MIN {
             vel.par_iter_mut().enumerate().for_each(body);
@@ -563,7 +598,7 @@ impl ShapeSolver {
             vel.iter_mut().enumerate().for_each(body);
         }
         for (r, (l, d)) in self.lambda.iter_mut().zip(&self.dl).enumerate() {
-            *l += d;
+            *l += d * scale;
             let inequality = match st.kinds[r] {
                 RowKind::Edge(_) => p.axial == ConstraintKind::StretchOnly,
                 RowKind::Tie(_) => true,
@@ -618,8 +653,8 @@ impl ShapeSolver {
         let mut report = ShapeReport::default();
         self.project(p, vel);
         let mut omega = 1.0;
+        let (mut violation, mut worst) = self.evaluate(p, vel);
         loop {
-            let (violation, worst) = self.evaluate(p, vel);
             report.violation = violation;
             report.worst = worst;
             if violation <= tol {
@@ -631,7 +666,7 @@ impl ShapeSolver {
             }
             let k = report.iterations;
             report.iterations += 1;
-            match method {
+            let newton = match method {
                 ShapeMethod::Direct { refactor_after } => {
                     let st = self.structure.as_mut().expect("prepared");
                     if self.last_cg > refactor_after || !st.system.is_factored() {
@@ -648,7 +683,7 @@ impl ShapeSolver {
                     )?;
                     self.last_cg = stats.iterations;
                     report.linear_iterations += stats.iterations;
-                    self.apply(p, vel);
+                    true
                 }
                 ShapeMethod::ConjugateGradient { cg_iterations } => {
                     let st = self.structure.as_mut().expect("prepared");
@@ -661,11 +696,12 @@ impl ShapeSolver {
                         Par::Seq,
                     )?;
                     report.linear_iterations += stats.iterations;
-                    self.apply(p, vel);
+                    true
                 }
                 ShapeMethod::Jacobi => {
                     self.jacobi(step);
-                    self.apply(p, vel);
+                    self.apply(p, vel, 1.0, false);
+                    false
                 }
                 ShapeMethod::Chebyshev { rho } => {
                     omega = match k {
@@ -678,7 +714,7 @@ impl ShapeSolver {
                     self.hat.copy_from_slice(vel);
                     self.lambda_hat.copy_from_slice(&self.lambda);
                     self.jacobi(step);
-                    self.apply(p, vel);
+                    self.apply(p, vel, 1.0, false);
                     if k > 0 {
                         for (v, prev) in vel.iter_mut().zip(&self.prev) {
                             *v = prev + (*v - prev) * omega;
@@ -689,11 +725,38 @@ impl ShapeSolver {
                     }
                     std::mem::swap(&mut self.prev, &mut self.hat);
                     std::mem::swap(&mut self.lambda_prev, &mut self.lambda_hat);
+                    false
                 }
-                ShapeMethod::GaussSeidel { omega } => self.gauss_seidel(p, vel, omega),
+                ShapeMethod::GaussSeidel { omega } => {
+                    self.gauss_seidel(p, vel, omega);
+                    false
+                }
+            };
+            if !newton {
+                after(vel);
+                self.project(p, vel);
+                (violation, worst) = self.evaluate(p, vel);
+                continue;
             }
-            after(vel);
-            self.project(p, vel);
+            // The Newton step, halved while it does not reduce Σ violation² (the merit); the
+            // last halving is taken whatever it gives.
+            let merit = self.merit;
+            self.saved_vel.copy_from_slice(vel);
+            self.lambda_prev.copy_from_slice(&self.lambda);
+            let mut scale = 1.0;
+            for halving in 0..=LINE_SEARCH_HALVINGS {
+                self.apply(p, vel, scale, true);
+                after(vel);
+                self.project(p, vel);
+                (violation, worst) = self.evaluate(p, vel);
+                if self.merit <= (1.0 - 1e-4 * scale) * merit || halving == LINE_SEARCH_HALVINGS {
+                    break;
+                }
+                vel.copy_from_slice(&self.saved_vel);
+                self.lambda.copy_from_slice(&self.lambda_prev);
+                scale *= 0.5;
+                report.backtracks += 1;
+            }
         }
         Ok(report)
     }
@@ -744,7 +807,7 @@ impl ShapeSolver {
                     self.dl[r] = omega * self.b[r] / self.diag[r];
                 }
             }
-            self.apply(p, vel);
+            self.apply(p, vel, 1.0, false);
         }
     }
 

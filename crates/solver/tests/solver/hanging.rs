@@ -48,7 +48,7 @@ fn hang_with(
     for k in 0..steps {
         let r = solver.step(&cloth, &mut state, &params).expect("step");
         if k + 100 >= steps {
-            iterations += r.internal_iterations[0] + r.internal_iterations[1];
+            iterations += r.internal_iterations;
             counted += 1;
             residual = r.internal_residual;
         }

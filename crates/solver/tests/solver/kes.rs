@@ -3,8 +3,6 @@
 
 use atelier_fabric::{AnisotropyForm, Branch, TensileState, units};
 use atelier_solver::kes::{self, Direction};
-use atelier_solver::{Solver, StepParams};
-use nalgebra::Vector3;
 
 use crate::common::fabric;
 
@@ -163,75 +161,4 @@ fn virtual_kes_bending_test_recovers_b_and_2hb() {
             "{name}: 2HB {two_hb} vs {hb_in}"
         );
     }
-}
-
-/// The KES-FB1 shear test with compliant diagonals (`ConstraintKind::Compliant`): a 20 × 5 cm
-/// strip, bottom edge clamped, the top edge pulled along the strip by a shear force per width τ
-/// under the instrument's 10 gf/cm pretension. The interior columns lean by γ = τ / G, G the
-/// fabric's KES shear stiffness; with rigid diagonals they do not lean at all.
-#[test]
-#[ignore = "the compliant diagonals (an option, not a default) are not right yet: the strip leans 2.76° (Chebyshev) or 4.52° (Jacobi) at τ = 1 gf/cm against τ/G = 0.667°, and is still moving after 3 s (kinetic energy 7e-4 J, shape residual 1e-7 m after 800 iterations): the compliant iteration has not reached its fixed point, so the lean depends on the iteration"]
-fn compliant_diagonals_shear_by_the_kes_stiffness() {
-    use atelier_solver::ConstraintKind;
-    let f = fabric("cotton_broad");
-    let g = f.shear.as_ref().expect("KES shear values").stiffness;
-    let (nu, nv, width, _) = kes::FB1_SPECIMEN;
-    let run = |kind: ConstraintKind, tau: f64| {
-        let (cloth, mut state) =
-            kes::fb1_specimen(&f, AnisotropyForm::Thesis, Direction::Warp).expect("specimen");
-        let params = StepParams {
-            dt: 0.01,
-            gravity: [0.0; 3],
-            damping: 5.0,
-            internal_tolerance: 1e-9,
-            internal_max_iterations: 200,
-            shape_tolerance: 1e-10,
-            shape_max_iterations: 400,
-            diagonal_constraint: kind,
-            ..StepParams::default()
-        };
-        let mut solver = Solver::new();
-        let h = width / (nu - 1) as f64;
-        let pre = units::force_from_kes(10.0);
-        solver.external_forces = vec![Vector3::zeros(); nu * nv];
-        for i in (nv - 1) * nu..nv * nu {
-            let share = if i % nu == 0 || i % nu == nu - 1 {
-                0.5 * h
-            } else {
-                h
-            };
-            solver.external_forces[i] = Vector3::new(tau * share, pre * share, 0.0);
-        }
-        for _ in 0..300 {
-            solver.step(&cloth, &mut state, &params).expect("step");
-        }
-        // Mean lean of the vertical edges of the interior columns.
-        let lean: Vec<f64> = (5..nu - 5)
-            .flat_map(|i| (0..nv - 1).map(move |j| (j * nu + i, (j + 1) * nu + i)))
-            .map(|(a, b)| {
-                let d = state.positions[b] - state.positions[a];
-                d.x.atan2(d.y)
-            })
-            .collect();
-        lean.iter().sum::<f64>() / lean.len() as f64
-    };
-    for kes in [1.0, 2.0, 4.0] {
-        let tau = units::force_from_kes(kes);
-        let gamma = run(ConstraintKind::Compliant, tau);
-        let want = tau / g;
-        eprintln!(
-            "τ = {kes} gf/cm: γ = {:.3}° (τ/G = {:.3}°)",
-            gamma.to_degrees(),
-            want.to_degrees()
-        );
-        assert!(
-            (gamma / want - 1.0).abs() < 0.1,
-            "τ = {kes} gf/cm: γ = {gamma} rad, τ/G = {want} rad"
-        );
-    }
-    let rigid = run(ConstraintKind::Equality, units::force_from_kes(2.0));
-    assert!(
-        rigid.abs() < 0.05 * units::force_from_kes(2.0) / g,
-        "rigid cells lean {rigid} rad"
-    );
 }

@@ -1,0 +1,146 @@
+//! A drape run from the command line, for the studies of `docs/validation.md`:
+//! `cargo run --release -p atelier-solver --example drape_probe -- FABRIC [key=value ...]`
+//! with keys `around`, `rings`, `dt`, `tol`, `cap`, `shear` (scale), `measure` (midpoint or
+//! corners), `b` (bending scale), `g` (scale of G), `hg` (scale of 2HG and 2HG5), `seed`,
+//! `max_time`, `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs). Prints the drape,
+//! the convergence counts and the wall time.
+
+use std::time::Instant;
+
+use atelier_fabric::{AnisotropyForm, Fabric};
+use atelier_solver::scenes::{DrapeScene, RestCriterion, run_drape};
+use atelier_solver::{ShapeMethod, ShearMeasure, Solver, StepParams};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let name = args.first().cloned().unwrap_or_else(|| "polyester_faille".into());
+    let get = |key: &str, default: f64| -> f64 {
+        args.iter()
+            .find_map(|a| a.strip_prefix(&format!("{key}=")))
+            .map_or(default, |v| v.parse().expect("number"))
+    };
+    let word = |key: &str, default: &str| -> String {
+        args.iter()
+            .find_map(|a| a.strip_prefix(&format!("{key}=")))
+            .unwrap_or(default)
+            .to_string()
+    };
+    let path = format!(
+        "{}/../../fixtures/fabrics/{name}.ron",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut fabric = Fabric::load(std::path::Path::new(&path)).expect("fabric");
+    if let Some(s) = fabric.shear.as_mut() {
+        s.stiffness *= get("g", 1.0);
+        s.hysteresis *= get("hg", 1.0);
+        if let Some(h5) = s.hysteresis_5deg.as_mut() {
+            *h5 *= get("hg", 1.0);
+        }
+    }
+    let b = get("b", 1.0);
+    if b != 1.0 {
+        fabric.bending = fabric.bending.map(|s| {
+            atelier_fabric::Spindle::new(s.rigidity() * b, s.residual_moment() * b).expect("B")
+        });
+    }
+    let mut scene = DrapeScene::jis(get("around", 72.0) as usize, get("rings", 8.0) as usize);
+    scene.perturbation = 1e-4;
+    scene.seed = get("seed", 1.0) as u64;
+    scene.cloth_options.form = AnisotropyForm::Compliance;
+    let method = match word("method", "direct").as_str() {
+        "cg" => ShapeMethod::ConjugateGradient { cg_iterations: 500 },
+        "jacobi" => ShapeMethod::Jacobi,
+        "chebyshev" => ShapeMethod::Chebyshev { rho: 0.99 },
+        "gs" => ShapeMethod::GaussSeidel { omega: 1.0 },
+        _ => ShapeMethod::DEFAULT,
+    };
+    let params = StepParams {
+        dt: get("dt", 0.01),
+        shape_tolerance: get("tol", 1e-4),
+        shape_max_iterations: get("cap", 100.0) as usize,
+        shear_scale: get("shear", 1.0),
+        shear_measure: if word("measure", "midpoint") == "corners" {
+            ShearMeasure::Corners
+        } else {
+            ShearMeasure::Midpoint
+        },
+        hysteresis: get("hysteresis", 1.0) != 0.0,
+        shape_method: method,
+        bending_off: get("bending_off", 0.0) != 0.0,
+        implicit_stick_slope: get("stick", 0.0) != 0.0,
+        damping: get("damping", 0.2),
+        collision_passes: get("passes", 2.0) as usize,
+        divergence_strain: get("divergence", 1.0),
+        ..StepParams::default()
+    };
+    let (cloth, mut state) = scene.build(&fabric).expect("scene");
+    let mut solver = Solver::new();
+    let stop = RestCriterion {
+        max_time: get("max_time", 6.0),
+        ..RestCriterion::default()
+    };
+    if get("verbose", 0.0) != 0.0 {
+        let steps = (get("max_time", 6.0) / params.dt).round() as usize;
+        for _ in 0..steps {
+            match solver.step(&cloth, &mut state, &params) {
+                Ok(r) => println!(
+                    "t {:.3} conv {} viol {:.2e} {:?} shape its {} fact {} lin {} internal {} {:.1e} {} bending {} {:.1e} vmax {:.3} ke {:.2e}",
+                    state.time,
+                    r.converged,
+                    r.violation,
+                    r.worst,
+                    r.shape_iterations,
+                    r.factorizations,
+                    r.linear_iterations,
+                    r.internal_iterations,
+                    r.internal_residual,
+                    r.internal_converged,
+                    r.bending_iterations,
+                    r.bending_residual,
+                    r.max_speed,
+                    r.kinetic_energy
+                ),
+                Err(e) => {
+                    println!("failed: {e}");
+                    return;
+                }
+            }
+        }
+        return;
+    }
+    let t0 = Instant::now();
+    let run = run_drape(&scene, &cloth, &mut state, &mut solver, &params, &stop);
+    let wall = t0.elapsed();
+    match run {
+        Ok(run) => {
+            println!(
+                "{name}: DC {:.1} % nodes {} settled {} t {:.2} s steps {} wall {:.1} s ({:.2} ms/step) unconverged {} mean shape its {:.1} max strain err {:.2e} max axial strain {:.2e}",
+                run.measure.drape_coefficient,
+                run.measure.nodes,
+                run.settled,
+                run.time,
+                run.steps,
+                wall.as_secs_f64(),
+                1e3 * wall.as_secs_f64() / run.steps as f64,
+                run.unconverged_steps,
+                run.mean_shape_iterations,
+                run.max_strain_error,
+                run.max_axial_strain,
+            );
+            let prominences: Vec<String> = run
+                .measure
+                .folds
+                .iter()
+                .map(|f| format!("{:.0}", 1e3 * f.prominence))
+                .collect();
+            println!("  prominences mm: {}", prominences.join(" "));
+            for s in run.trace.iter().step_by(5) {
+                println!(
+                    "  t {:.1} DC {:.1} nodes {} v {:.4}",
+                    s.time, s.drape_coefficient, s.nodes, s.rms_speed
+                );
+            }
+        }
+        Err(e) => println!("{name}: failed: {e}"),
+    }
+}
