@@ -52,6 +52,7 @@ fn main() {
         "jacobi" => ShapeMethod::Jacobi,
         "chebyshev" => ShapeMethod::Chebyshev { rho: 0.99 },
         "gs" => ShapeMethod::GaussSeidel { omega: 1.0 },
+        "direct0" => ShapeMethod::Direct { refactor_after: 0 },
         _ => ShapeMethod::DEFAULT,
     };
     let params = StepParams {
@@ -82,6 +83,10 @@ fn main() {
     if get("verbose", 0.0) != 0.0 {
         let steps = (get("max_time", 6.0) / params.dt).round() as usize;
         for _ in 0..steps {
+            if state.time < get("from", 0.0) - 1e-9 {
+                solver.step(&cloth, &mut state, &params).expect("step");
+                continue;
+            }
             match solver.step(&cloth, &mut state, &params) {
                 Ok(r) => println!(
                     "t {:.3} conv {} viol {:.2e} {:?} shape its {} fact {} lin {} internal {} {:.1e} {} bending {} {:.1e} vmax {:.3} ke {:.2e}",

@@ -62,6 +62,22 @@ pub enum ConstraintKind {
     StretchOnly,
 }
 
+/// How bending enters the step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BendingModel {
+    /// Bending as compliant constraints of the shape stage, solved with the other constraints
+    /// (backward Euler: no stability limit from bending): for each node and grid direction with
+    /// both neighbours, the turn of the grid line n·(t₊ − t₋) ≈ l̄·η held by a compliance from
+    /// the spindle's local slope, linearised about the start of the step (the spindle's
+    /// hysteresis then advances once per step, as the shear loop's). The default.
+    #[default]
+    Implicit,
+    /// The thesis (28)–(32): an explicit force along the node normals from the slots' circle
+    /// curvatures, with the linearised implicit term of `implicit_bending` (stable only up to
+    /// Δt ≈ 0.4·h s/m; `docs/solver.md`).
+    Thesis,
+}
+
 /// The thresholds ε^c (internal forces) and ε^e (shape), fixed or scaled with the cloth's speed
 /// (thesis, end of §3.8.2: loose while the cloth moves fast, tight as it settles).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -136,8 +152,10 @@ pub struct StepParams {
     pub shear_deadband: f64,
     /// Tolerance policy. Default `Fixed`.
     pub tolerance_policy: TolerancePolicy,
-    /// Treat the bending stiffness of each node implicitly along its normal (a linearised
-    /// implicit term solved by BiCGSTAB). Lifts the explicit limit Δt < 2√(μ/k) on fine grids and
+    /// How bending enters the step. Default `Implicit`.
+    pub bending_model: BendingModel,
+    /// [`BendingModel::Thesis`] only: treat the bending stiffness of each node implicitly along
+    /// its normal (a linearised implicit term solved by BiCGSTAB). Lifts the explicit limit Δt < 2√(μ/k) on fine grids and
     /// stiff fabrics; changes no equilibrium. Default true.
     pub implicit_bending: bool,
     /// Relative residual at which the implicit bending solve stops. Range (0, 1); default 1e-6.
@@ -193,6 +211,7 @@ impl Default for StepParams {
             shear_scale: 1.0,
             shear_deadband: 1e-4,
             tolerance_policy: TolerancePolicy::Fixed,
+            bending_model: BendingModel::Implicit,
             implicit_bending: true,
             bending_tolerance: 1e-6,
             bending_max_iterations: 200,

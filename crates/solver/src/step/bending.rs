@@ -6,7 +6,7 @@ use atelier_grid::{NO_NODE, SLOTS};
 use super::par::fill;
 use super::{Solver, V3};
 use crate::cloth::Cloth;
-use crate::params::StepParams;
+use crate::params::{BendingModel, StepParams};
 use crate::state::ClothState;
 
 /// A bending characteristic with the step's regularisation: stick slope and reversal dead band
@@ -25,9 +25,10 @@ impl Solver {
     /// from the spindle (peeked through the hysteresis state), node moment
     /// M = Σ_dir ½ Σ W_a m_a over directions with both neighbours (a free edge carries no moment),
     /// force F = n Σ (M_a − M)/l_a. Also the diagonal bending stiffness for the implicit term.
-    /// With `bending_off`: no force and no stiffness.
+    /// With `bending_off`, or the implicit bending model (bending is then a constraint of the
+    /// shape stage, `targets.rs`): no force and no stiffness.
     pub(super) fn bending(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
-        if params.bending_off {
+        if params.bending_off || params.bending_model == BendingModel::Implicit {
             self.s.f_sum.iter_mut().for_each(|f| *f = V3::zeros());
             self.s.slot_coef.iter_mut().for_each(|k| *k = [0.0; SLOTS]);
             return;

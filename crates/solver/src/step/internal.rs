@@ -51,6 +51,12 @@ impl Solver {
         self.gather(cloth, false);
         let e = self.energy(cloth);
         let residual = if e0 > 0.0 { e / e0 } else { 0.0 };
+        // The force the velocity takes (deviation from (18), `docs/solver.md`): F^sum without the
+        // internal forces Σ p d. They lie along the edges at the start of the step, which the
+        // converged shape stage's corrections span, so they change a converged step only at
+        // second order — by their components along the motion as the edges turn, an explicit
+        // force that pumped energy into a swinging drape at Δt 10 ms. p still sets the targets.
+        self.s.f_m.copy_from_slice(&self.s.f_sum);
         if self.pressure.is_some() {
             // The surface's reaction was balanced in; the velocity carries the load into the
             // surface again, so that the contact's friction feels it.

@@ -198,6 +198,7 @@ impl Solver {
             time,
         )?;
         self.cell_shear(cloth, state, params);
+        self.node_bend(cloth, state, params);
         let pressure_before = report.timings.pressure;
         self.shape_stage(
             cloth,

@@ -67,6 +67,21 @@ pub struct CellShear {
     pub lock: f64,
 }
 
+/// One node's bending along one grid direction for this step (the implicit bending model): the
+/// turn of the grid line through the node, C = n·(t₊ − t₋) with n the node normal at the start
+/// of the step and t± the unit vectors of the edges beyond and before the node, held by a
+/// compliant constraint linearised about the start of the step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeBend {
+    /// Node normal at the start of the step (frozen over the step).
+    pub normal: V3,
+    /// The turn at which the linearised moment vanishes, C₀ − m₀·l̄/k.
+    pub offset: f64,
+    /// Compliance l̄²/(k·S) (k the spindle's local slope, N·m; S the node's area; l̄ the mean
+    /// rest length of the two edges).
+    pub compliance: f64,
+}
+
 /// What the shape stage works on in one step.
 pub struct ShapeProblem<'a> {
     /// The cloth.
@@ -85,6 +100,9 @@ pub struct ShapeProblem<'a> {
     pub measure: ShearMeasure,
     /// One entry per cell; empty for no shear constraints.
     pub shear: &'a [CellShear],
+    /// Two entries per node (u, v direction; used where the node has both neighbours in that
+    /// direction); empty for no bending constraints.
+    pub bends: &'a [NodeBend],
     /// Node pairs held within a length (length 0: sewn, one point).
     pub ties: &'a [Tie],
     /// One per node; a zero normal for none.
@@ -100,6 +118,8 @@ pub enum Constraint {
     Cell(usize),
     /// A tie being drawn together (index in the step's ties).
     Tie(usize),
+    /// A node's bending along a grid direction (node index, 0 for u and 1 for v).
+    Bend(usize, u8),
     /// A node's contact plane (node index).
     Plane(usize),
 }
@@ -128,6 +148,8 @@ enum RowKind {
     Edge(u32),
     Cell(u32),
     Tie(u32),
+    /// Node, direction (0 u, 1 v); the neighbours before and after.
+    Bend(u32, u8, [u32; 2]),
 }
 
 /// The rows and their system, for one grouping of the nodes and one set of open ties.
@@ -148,6 +170,7 @@ struct Structure {
     root: Vec<u32>,
     open_ties: Vec<(u32, u32)>,
     with_cells: bool,
+    with_bends: bool,
 }
 
 /// The shape stage's persistent state: the system (rebuilt only when the rows change), the
@@ -176,7 +199,6 @@ pub struct ShapeSolver {
     saved_vel: Vec<V3>,
     /// Σ violation² of the last evaluation (the line search's merit).
     merit: f64,
-    last_cg: usize,
     /// Symbolic analyses made (diagnostics).
     pub analyses: usize,
 }
@@ -255,11 +277,15 @@ impl ShapeSolver {
             }
         }
         let with_cells = !p.shear.is_empty();
+        let with_bends = !p.bends.is_empty();
         let same = self.structure.as_ref().is_some_and(|s| {
-            s.root == self.root && s.open_ties == self.open_ties && s.with_cells == with_cells
+            s.root == self.root
+                && s.open_ties == self.open_ties
+                && s.with_cells == with_cells
+                && s.with_bends == with_bends
         });
         if !same {
-            self.structure = Some(self.build(cloth, with_cells)?);
+            self.structure = Some(self.build(cloth, with_cells, with_bends)?);
             self.analyses += 1;
         }
         let st = self.structure.as_mut().expect("built");
@@ -304,7 +330,12 @@ impl ShapeSolver {
         Ok(())
     }
 
-    fn build(&self, cloth: &Cloth, with_cells: bool) -> Result<Structure, DualError> {
+    fn build(
+        &self,
+        cloth: &Cloth,
+        with_cells: bool,
+        with_bends: bool,
+    ) -> Result<Structure, DualError> {
         let topo = cloth.topology();
         let n = topo.node_count();
         let root = &self.root;
@@ -346,6 +377,21 @@ impl ShapeSolver {
         for (k, &(a, b)) in self.open_ties.iter().enumerate() {
             push(RowKind::Tie(k as u32), &[a, b]);
         }
+        if with_bends {
+            let axial = topo.axial_neighbours();
+            for (i, slots) in axial.iter().enumerate() {
+                for dir in 0..2u8 {
+                    // Slots: +u, −u, +v, −v.
+                    let (after, before) = (slots[2 * dir as usize], slots[2 * dir as usize + 1]);
+                    if after != atelier_grid::NO_NODE && before != atelier_grid::NO_NODE {
+                        push(
+                            RowKind::Bend(i as u32, dir, [before, after]),
+                            &[before, i as u32, after],
+                        );
+                    }
+                }
+            }
+        }
         let system = DualSystem::new(n, &rows)?;
         // Row counts per node for the Jacobi scaling.
         let mut count = vec![0u32; n];
@@ -380,6 +426,7 @@ impl ShapeSolver {
             root: self.root.clone(),
             open_ties: self.open_ties.clone(),
             with_cells,
+            with_bends,
         })
     }
 
@@ -483,6 +530,31 @@ impl ShapeSolver {
                         (gamma - sh.offset, sh.compliance / dt2, false, 1.0, true)
                     }
                 }
+                RowKind::Bend(i, dir, [before, after]) => {
+                    let bend = &p.bends[2 * i as usize + dir as usize];
+                    let n = bend.normal;
+                    let xi = pred[i as usize];
+                    let (ea, eb) = (xi - pred[before as usize], pred[after as usize] - xi);
+                    let (la, lb) = (ea.norm(), eb.norm());
+                    if la > 0.0 && lb > 0.0 {
+                        let (ta, tb) = (ea / la, eb / lb);
+                        let ga = (n - ta * n.dot(&ta)) / la;
+                        let gb = (n - tb * n.dot(&tb)) / lb;
+                        // C = n·t₊ − n·t₋: ∂/∂x₊ = g_b, ∂/∂x₋ = g_a, ∂/∂x_i = −g_a − g_b.
+                        g[slot[0] as usize] += ga;
+                        g[slot[1] as usize] -= ga + gb;
+                        g[slot[2] as usize] += gb;
+                        (
+                            n.dot(&tb) - n.dot(&ta) - bend.offset,
+                            bend.compliance / dt2,
+                            false,
+                            1.0,
+                            true,
+                        )
+                    } else {
+                        (0.0, 1.0, false, 1.0, true)
+                    }
+                }
                 RowKind::Tie(t) => {
                     let tie = &ties[tie_index[t as usize] as usize];
                     let d = pred[tie.b as usize] - pred[tie.a as usize];
@@ -548,6 +620,7 @@ impl ShapeSolver {
                 let which = match st.kinds[r] {
                     RowKind::Edge(e) => Constraint::Edge(e as usize),
                     RowKind::Cell(c) => Constraint::Cell(c as usize),
+                    RowKind::Bend(i, d, _) => Constraint::Bend(i as usize, d),
                     RowKind::Tie(t) => Constraint::Tie(self.open_tie_index[t as usize] as usize),
                 };
                 worst = (v, Some(which));
@@ -602,7 +675,7 @@ impl ShapeSolver {
             let inequality = match st.kinds[r] {
                 RowKind::Edge(_) => p.axial == ConstraintKind::StretchOnly,
                 RowKind::Tie(_) => true,
-                RowKind::Cell(_) => false,
+                RowKind::Cell(_) | RowKind::Bend(..) => false,
             };
             if inequality && *l > 0.0 {
                 *l = 0.0;
@@ -668,21 +741,39 @@ impl ShapeSolver {
             report.iterations += 1;
             let newton = match method {
                 ShapeMethod::Direct { refactor_after } => {
+                    // CG preconditioned by the factorization at hand (made first when there is
+                    // none); when it does not reach the tolerance within `refactor_after`
+                    // iterations the factorization is renewed and the solve repeated, so every
+                    // Newton step is solved to LINEAR_TOLERANCE.
                     let st = self.structure.as_mut().expect("prepared");
-                    if self.last_cg > refactor_after || !st.system.is_factored() {
+                    let mut fresh = false;
+                    if !st.system.is_factored() {
                         st.system.factorize(Par::Seq)?;
                         report.factorizations += 1;
+                        fresh = true;
                     }
-                    let stats = st.system.solve(
+                    let mut stats = st.system.solve(
                         &self.b,
                         &mut self.dl,
                         LINEAR_TOLERANCE,
-                        LINEAR_CAP,
+                        if fresh { LINEAR_CAP } else { refactor_after.max(1) },
                         Preconditioner::Factor,
                         Par::Seq,
                     )?;
-                    self.last_cg = stats.iterations;
                     report.linear_iterations += stats.iterations;
+                    if stats.relative_residual > LINEAR_TOLERANCE && !fresh {
+                        st.system.factorize(Par::Seq)?;
+                        report.factorizations += 1;
+                        stats = st.system.solve(
+                            &self.b,
+                            &mut self.dl,
+                            LINEAR_TOLERANCE,
+                            LINEAR_CAP,
+                            Preconditioner::Factor,
+                            Par::Seq,
+                        )?;
+                        report.linear_iterations += stats.iterations;
+                    }
                     true
                 }
                 ShapeMethod::ConjugateGradient { cg_iterations } => {
@@ -936,6 +1027,7 @@ mod tests {
             axial: ConstraintKind::Equality,
             measure: ShearMeasure::Midpoint,
             shear: &cells,
+            bends: &[],
             ties: &[],
             planes: &planes,
         };

@@ -4,7 +4,7 @@
 use atelier_grid::SLOTS;
 
 use super::par::resize;
-use super::projection::CellShear;
+use super::projection::{CellShear, NodeBend};
 use super::{Solver, Tie, V3};
 use crate::cloth::Cloth;
 
@@ -47,6 +47,8 @@ pub(super) struct Scratch {
     pub(super) shear: Vec<f64>,
     /// Each cell's shear constraint of this step (empty: none).
     pub(super) cell_shear: Vec<CellShear>,
+    /// Each node's bending constraints of this step, u and v (empty: none).
+    pub(super) node_bend: Vec<NodeBend>,
     /// Contact planes set by the hooks this step.
     pub(super) planes: Vec<atelier_collide::ContactPlane>,
     /// The surface's reaction on the nodes lying on it (pressure stage only).

@@ -46,6 +46,7 @@ impl Solver {
                 axial: params.axial_constraint,
                 measure: params.shear_measure,
                 shear: &s.cell_shear,
+                bends: &s.node_bend,
                 ties: &s.ties,
                 planes: &s.planes,
             };
@@ -97,6 +98,7 @@ impl Solver {
             axial: params.axial_constraint,
             measure: params.shear_measure,
             shear: &s.cell_shear,
+            bends: &s.node_bend,
             ties: &s.ties,
             planes: &s.planes,
         };

@@ -4,11 +4,14 @@
 
 use atelier_fabric::Branch;
 
+use atelier_grid::NO_NODE;
+
 use super::Solver;
+use super::bending::regularised;
 use super::par::fill;
-use super::projection::CellShear;
+use super::projection::{CellShear, NodeBend};
 use crate::cloth::Cloth;
-use crate::params::StepParams;
+use crate::params::{BendingModel, StepParams};
 use crate::shear_angle::cell_angle;
 use crate::state::ClothState;
 
@@ -97,6 +100,66 @@ impl Solver {
                 offset: gamma - tau / k,
                 compliance: 1.0 / (k * cell.area),
                 lock,
+            }
+        });
+    }
+}
+
+impl Solver {
+    /// Each node's bending constraints for this step ([`BendingModel::Implicit`]): per grid
+    /// direction with both neighbours, the turn C₀ = n·(t₊ − t₋) at the start of the step (n the
+    /// node normal of stage 1), the curvature η₀ = C₀/l̄, the spindle's moment per width m₀ and
+    /// local slope k there (through the hysteresis state of the direction's `+` slot; Bη and B
+    /// without hysteresis); the constraint C − (C₀ − m₀ l̄/k) = 0 with compliance l̄²/(k·S).
+    /// Nothing with the thesis's bending model or `bending_off`.
+    pub(super) fn node_bend(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
+        if params.bending_model != BendingModel::Implicit || params.bending_off {
+            self.s.node_bend.clear();
+            return;
+        }
+        let topo = cloth.topology();
+        let n = topo.node_count();
+        self.s.node_bend.resize(2 * n, NodeBend::default());
+        let (axial, axial_edges, areas, mats, table, edges) = (
+            topo.axial_neighbours(),
+            topo.axial_edges(),
+            topo.node_areas(),
+            cloth.slot_materials(),
+            cloth.materials(),
+            topo.edges(),
+        );
+        let hysteresis = params.hysteresis && cloth.bending_hysteretic();
+        let (stick, band) = (params.bending_stick_slope, params.bending_deadband);
+        let (pos, states, normal) = (&state.positions, &state.bending, &self.s.normal);
+        fill(&mut self.s.node_bend, |k| {
+            let (i, dir) = (k / 2, k % 2);
+            let (after, before) = (axial[i][2 * dir], axial[i][2 * dir + 1]);
+            if after == NO_NODE || before == NO_NODE {
+                return NodeBend::default();
+            }
+            let l = 0.5
+                * (edges[axial_edges[i][2 * dir] as usize].rest_length
+                    + edges[axial_edges[i][2 * dir + 1] as usize].rest_length);
+            let nrm = normal[i];
+            let (ea, eb) = (pos[i] - pos[before as usize], pos[after as usize] - pos[i]);
+            let c0 = nrm.dot(&(eb / eb.norm())) - nrm.dot(&(ea / ea.norm()));
+            let eta = c0 / l;
+            let spindle = regularised(table.bending(mats[i][2 * dir]), stick, band);
+            let b = spindle.rigidity();
+            let (m, slope) = if hysteresis && spindle.is_hysteretic() {
+                let st = &states[i][2 * dir];
+                // The local slope, by a central difference over a small part of the spindle's
+                // reversal width, within the spindle's own bounds [B, stick·B].
+                let h = 1e-3 * spindle.residual_moment() / b;
+                let slope = (st.moment(&spindle, eta + h) - st.moment(&spindle, eta - h)) / (2.0 * h);
+                (st.moment(&spindle, eta), slope.clamp(b, stick.max(1.0) * b))
+            } else {
+                (b * eta, b)
+            };
+            NodeBend {
+                normal: nrm,
+                offset: c0 - m * l / slope,
+                compliance: l * l / (slope * areas[i]),
             }
         });
     }

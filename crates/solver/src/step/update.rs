@@ -8,7 +8,7 @@ use super::StepError;
 use super::bending::regularised;
 use super::par::fill;
 use crate::cloth::Cloth;
-use crate::params::{ConstraintKind, StepParams};
+use crate::params::{BendingModel, ConstraintKind, StepParams};
 use crate::shear_angle::cell_angle;
 use crate::state::ClothState;
 
@@ -102,7 +102,41 @@ impl Solver {
                 st.update(&l, gamma);
             }
         }
-        if cloth.bending_hysteretic() && !params.bending_off {
+        if cloth.bending_hysteretic() && !self.s.node_bend.is_empty() {
+            // The implicit model: each direction's curvature at the end of the step, the turn of
+            // its grid line about the step's node normal over the mean rest length.
+            let (axial, axial_edges, smats, edges, pos) = (
+                topo.axial_neighbours(),
+                topo.axial_edges(),
+                cloth.slot_materials(),
+                topo.edges(),
+                &state.positions,
+            );
+            for (i, slots) in state.bending.iter_mut().enumerate() {
+                for dir in 0..2 {
+                    let (after, before) = (axial[i][2 * dir], axial[i][2 * dir + 1]);
+                    if after == NO_NODE || before == NO_NODE {
+                        continue;
+                    }
+                    let l = 0.5
+                        * (edges[axial_edges[i][2 * dir] as usize].rest_length
+                            + edges[axial_edges[i][2 * dir + 1] as usize].rest_length);
+                    let nrm = self.s.node_bend[2 * i + dir].normal;
+                    let (ea, eb) = (pos[i] - pos[before as usize], pos[after as usize] - pos[i]);
+                    let eta =
+                        (nrm.dot(&(eb / eb.norm())) - nrm.dot(&(ea / ea.norm()))) / l;
+                    let spindle = regularised(
+                        table.bending(smats[i][2 * dir]),
+                        params.bending_stick_slope,
+                        params.bending_deadband,
+                    );
+                    slots[2 * dir].update(&spindle, eta);
+                }
+            }
+        } else if cloth.bending_hysteretic()
+            && !params.bending_off
+            && params.bending_model == BendingModel::Thesis
+        {
             let (axial, smats, eta) =
                 (topo.axial_neighbours(), cloth.slot_materials(), &self.s.eta);
             for (i, slots) in state.bending.iter_mut().enumerate() {

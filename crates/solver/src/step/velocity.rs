@@ -6,7 +6,7 @@ use atelier_grid::{NO_NODE, SLOTS};
 use super::par::fill;
 use super::{Solver, V3};
 use crate::cloth::Cloth;
-use crate::params::StepParams;
+use crate::params::{BendingModel, StepParams};
 use crate::state::ClothState;
 
 impl Solver {
@@ -23,7 +23,9 @@ impl Solver {
         let dt = params.dt;
         let (mass, areas) = (cloth.masses(), cloth.topology().node_areas());
         let axial = cloth.topology().axial_neighbours();
-        let implicit = params.implicit_bending && !params.bending_off;
+        let implicit = params.implicit_bending
+            && !params.bending_off
+            && params.bending_model == BendingModel::Thesis;
         let s = &mut self.s;
         let (f_m, normal) = (&s.f_m, &s.normal);
         let (vel0, pos) = (&state.velocities, &state.positions);
