@@ -62,6 +62,22 @@ pub enum ConstraintKind {
     StretchOnly,
 }
 
+/// Where the axial force p of each edge — the force its tensile characteristic reads its
+/// target strain at, (25) — comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Tension {
+    /// The edge constraints' forces of the previous step's shape stage (−λ/Δt², the force the
+    /// constraint actually exerted): nothing to solve, consistent with the dynamics. The
+    /// default.
+    #[default]
+    Constraint,
+    /// The thesis (43)–(47): forces p ≥ 0 that balance the external and bending forces at the
+    /// start of the step as far as the edges can, by projected descent to `internal_tolerance`
+    /// (it cannot balance a load across the cloth, and on long chains it needs many
+    /// iterations: `docs/solver.md`).
+    Balance,
+}
+
 /// How bending enters the step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum BendingModel {
@@ -109,7 +125,9 @@ pub struct StepParams {
     /// default 0.2 (a light fabric's terminal speed of a few m/s; a physical value, not a
     /// convergence aid — see `docs/solver.md`).
     pub damping: f64,
-    /// Internal-force method. Default `Accelerated`.
+    /// Where the edges' axial forces come from. Default `Constraint`.
+    pub tension: Tension,
+    /// Internal-force method ([`Tension::Balance`]). Default `Accelerated`.
     pub internal_method: InternalMethod,
     /// Internal-force step γ as a fraction of the largest stable step 1/λ_max(AᵀA). Range (0, 2);
     /// default 1.
@@ -197,6 +215,7 @@ impl Default for StepParams {
             dt: 0.01,
             gravity: [0.0, 0.0, -atelier_fabric::STANDARD_GRAVITY],
             damping: 0.2,
+            tension: Tension::Constraint,
             internal_method: InternalMethod::Accelerated,
             internal_step: 1.0,
             internal_tolerance: 1e-4,

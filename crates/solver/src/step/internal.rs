@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use super::par::{PAR_MIN, SUM_CHUNK, det_sum, fill, resize};
 use super::{Solver, V3};
 use crate::cloth::Cloth;
-use crate::params::{InternalMethod, StepParams};
+use crate::params::{InternalMethod, StepParams, Tension};
 use crate::state::ClothState;
 
 /// One chunk of the fused internal-force pass: (chunk index, ((forces, previous forces),
@@ -39,6 +39,17 @@ impl Solver {
         params: &StepParams,
         factor: f64,
     ) -> (usize, f64, bool) {
+        if params.tension == Tension::Constraint {
+            // The forces are the last step's constraint forces; nothing to balance.
+            self.s.p.copy_from_slice(&state.axial_force);
+            self.s.f_m.copy_from_slice(&self.s.f_sum);
+            if self.pressure.is_some() {
+                for (f, r) in self.s.f_m.iter_mut().zip(&self.s.reaction) {
+                    *f -= r;
+                }
+            }
+            return (0, 0.0, true);
+        }
         if self.lambda.is_none() {
             self.lambda = Some([self.estimate_lambda(cloth, false), 1.0]);
         }

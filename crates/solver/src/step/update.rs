@@ -8,7 +8,7 @@ use super::StepError;
 use super::bending::regularised;
 use super::par::fill;
 use crate::cloth::Cloth;
-use crate::params::{BendingModel, ConstraintKind, StepParams};
+use crate::params::{BendingModel, ConstraintKind, StepParams, Tension};
 use crate::shear_angle::cell_angle;
 use crate::state::ClothState;
 
@@ -63,6 +63,19 @@ impl Solver {
             .zip(&self.s.exit)
         {
             *v = w + e;
+        }
+        if params.tension == Tension::Constraint {
+            // This step's constraint forces: what the next step's targets read, and the force
+            // at which the tensile hysteresis is committed.
+            self.projection.edge_forces(params.dt, &mut self.s.p);
+            let (widths, edges, p) = (cloth.edge_widths(), cloth.topology().edges(), &self.s.p);
+            fill(&mut self.s.force_per_width, |e| {
+                if edges[e].kind.is_axial() {
+                    p[e] / widths[e]
+                } else {
+                    0.0
+                }
+            });
         }
         state.axial_force.copy_from_slice(&self.s.p);
         // The cells' shear angles at the end of the step, by the step's measure.
