@@ -24,6 +24,8 @@ use faer::Par;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
+use atelier_fabric::{Branch, MaterialTable, TensileState};
+
 use crate::cloth::Cloth;
 use crate::dual::{DualError, DualSystem, NONE, NodeWeight, Preconditioner, SLOTS};
 use crate::params::{ConstraintKind, ShapeMethod};
@@ -45,7 +47,7 @@ const LINEAR_CAP: usize = 50;
 
 /// The largest move of a node in one Newton step, as a fraction of its spacing (a trust
 /// region against the huge steps of a nearly singular system).
-const MAX_MOVE: f64 = 0.5;
+const MAX_MOVE: f64 = 0.1;
 
 /// Backtracking halvings of a Newton step before it is taken as it is.
 const LINE_SEARCH_HALVINGS: usize = 6;
@@ -82,6 +84,43 @@ pub struct NodeBend {
     pub compliance: f64,
 }
 
+/// The axial edges' tensile characteristics, for [`Tension::Constraint`]: each edge's target
+/// strain read at the force its own constraint exerts in the solve (implicit in the force).
+#[derive(Clone, Copy)]
+pub struct EdgeTension<'a> {
+    /// Per-angle materials.
+    pub table: &'a MaterialTable,
+    /// Material entry of each edge.
+    pub materials: &'a [u32],
+    /// Width each edge carries, m.
+    pub widths: &'a [f64],
+    /// Tensile hysteresis state of each edge (peeked).
+    pub states: &'a [TensileState],
+    /// Whether to read through the states (false: the loading branch).
+    pub hysteresis: bool,
+}
+
+impl EdgeTension<'_> {
+    /// The strain of edge `e` at force per width `f` (N/m) and dε/df there (by a forward
+    /// difference over a small part of the loop's range; 0 in compression, where the strain
+    /// does not change).
+    #[inline]
+    fn strain_and_slope(&self, e: usize, f: f64) -> (f64, f64) {
+        let l = self.table.tensile(self.materials[e]);
+        let at = |f: f64| {
+            if self.hysteresis {
+                self.states[e].strain(l, f)
+            } else {
+                l.strain(Branch::Loading, f)
+            }
+        };
+        let f = f.max(0.0);
+        let h = 1e-6 * l.max_force() + 1e-3 * f;
+        let eps = at(f);
+        (eps, ((at(f + h) - eps) / h).max(0.0))
+    }
+}
+
 /// What the shape stage works on in one step.
 pub struct ShapeProblem<'a> {
     /// The cloth.
@@ -98,8 +137,13 @@ pub struct ShapeProblem<'a> {
     /// fraction cΔt/(μ + cΔt) of the static load: a cantilever at rest drooped as under 4 %
     /// less gravity at Δt 5 ms).
     pub damping: f64,
-    /// Target length of every edge (axial ones used), m.
+    /// Target length of every edge (axial ones used), m; with `tension` set, only for
+    /// reports (the targets then follow the solve's forces).
     pub targets: &'a [f64],
+    /// With [`Tension::Constraint`]: the tensile characteristics the edge targets are read from
+    /// at each edge's own constraint force, l̄ = l⁰(1 + φ(−λ/(W·Δt²))), with the compliance
+    /// l⁰φ'/(W·Δt²) in the Newton system.
+    pub tension: Option<EdgeTension<'a>>,
     /// Axial edges: equality or stretch-only.
     pub axial: ConstraintKind,
     /// How a cell's angle is measured.
@@ -167,8 +211,11 @@ struct Structure {
     corner_slot: Vec<[u8; 4]>,
     /// Each row's nodes (roots), [`NONE`] for unused slots.
     row_nodes: Vec<[u32; SLOTS]>,
-    /// Rows that can never act (all their nodes one point).
+    /// Rows that cannot act: all their nodes one point (fixed by the structure), or none of
+    /// their nodes free to move (set each step from the pins).
     dead: Vec<bool>,
+    /// Rows dead by the structure alone.
+    collapsed: Vec<bool>,
     /// Jacobi scaling: 1 / the largest row count over the row's nodes.
     local_scale: Vec<f64>,
     /// Rows in colours sharing no node (Gauss–Seidel), built on first use.
@@ -318,6 +365,16 @@ impl ShapeSolver {
                 .sum();
             st.system.weight[r].w = if pinned || m <= 0.0 { 0.0 } else { 1.0 / m };
         }
+        // A row none of whose nodes can move cannot act (an edge between two pins: its length
+        // is the pins' business, not the solve's).
+        for r in 0..st.kinds.len() {
+            let weight = &st.system.weight;
+            st.dead[r] = st.collapsed[r]
+                || st.row_nodes[r]
+                    .iter()
+                    .filter(|&&k| k != NONE)
+                    .all(|&k| weight[k as usize].w == 0.0);
+        }
         let rows = st.kinds.len();
         for v in [
             &mut self.lambda,
@@ -434,6 +491,7 @@ impl ShapeSolver {
             kinds,
             corner_slot,
             row_nodes: rows,
+            collapsed: dead.clone(),
             dead,
             local_scale,
             colours: Vec::new(),
@@ -524,11 +582,22 @@ impl ShapeSolver {
                     let n = if l > 0.0 { d / l } else { V3::zeros() };
                     g[slot[0] as usize] -= n;
                     g[slot[1] as usize] += n;
+                    let l0 = edge.rest_length;
+                    let (target, compliance) = match &p.tension {
+                        Some(t) => {
+                            let w = t.widths[e as usize];
+                            let (eps, slope) = t.strain_and_slope(e as usize, -lam / (w * dt2));
+                            (l0 * (1.0 + eps), l0 * slope / (w * dt2))
+                        }
+                        None => (p.targets[e as usize], 0.0),
+                    };
+                    // The compliance is in the target already (it moves with λ), so the
+                    // residual is the length error itself.
                     (
-                        l - p.targets[e as usize],
-                        0.0,
+                        l - target,
+                        compliance,
                         p.axial == ConstraintKind::StretchOnly,
-                        edge.rest_length,
+                        l0,
                         false,
                     )
                 }
@@ -583,6 +652,9 @@ impl ShapeSolver {
                 }
             };
             let active = !inequality || value > 0.0 || lam < 0.0;
+            // Rows whose compliance lives in their value (edges: the target follows λ) take
+            // no α̃λ term in their residual.
+            let implicit_target = matches!(kinds[r], RowKind::Edge(_));
             *c = value;
             if !active {
                 for gk in g.iter_mut() {
@@ -603,7 +675,11 @@ impl ShapeSolver {
             } else {
                 HARD_REGULARISATION * stiff.max(f64::MIN_POSITIVE)
             };
-            *b = -(value + *extra * lam);
+            *b = if implicit_target {
+                -value
+            } else {
+                -(value + *extra * lam)
+            };
             *viol = if residual_is_compliant {
                 (value + *extra * lam).abs()
             } else if inequality {
@@ -862,6 +938,9 @@ impl ShapeSolver {
                 }
                 vel.copy_from_slice(&self.saved_vel);
                 self.lambda.copy_from_slice(&self.lambda_prev);
+                // The gradients back at the restored positions (the trial's evaluation
+                // replaced them; Δx = W Jᵀ Δλ needs the Jacobian the step was solved with).
+                self.evaluate(p, vel);
                 scale *= 0.5;
                 report.backtracks += 1;
             }
@@ -924,6 +1003,7 @@ impl ShapeSolver {
     /// row get 0).
     pub fn edge_forces(&self, dt: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|f| *f = 0.0);
+
         if let Some(st) = &self.structure {
             for (r, kind) in st.kinds.iter().enumerate() {
                 if let RowKind::Edge(e) = kind {
@@ -1056,6 +1136,7 @@ mod tests {
             time: 0.0,
             damping: 0.0,
             targets: &targets,
+            tension: None,
             axial: ConstraintKind::Equality,
             measure: ShearMeasure::Midpoint,
             shear: &cells,

@@ -4,11 +4,11 @@
 
 use std::time::{Duration, Instant};
 
-use super::projection::{ShapeProblem, ShapeReport};
+use super::projection::{EdgeTension, ShapeProblem, ShapeReport};
 use super::report::{Stage, StepError, StepReport, guard_nodes};
 use super::{CollisionHook, Solver};
 use crate::cloth::Cloth;
-use crate::params::{ShapeMethod, StepParams};
+use crate::params::{ShapeMethod, StepParams, Tension};
 use crate::state::ClothState;
 
 impl Solver {
@@ -35,6 +35,13 @@ impl Solver {
         let mut collision = Duration::ZERO;
         let mut pressure = Duration::ZERO;
         let mut last = ShapeReport::default();
+        let tension = (params.tension == Tension::Constraint).then(|| EdgeTension {
+            table: cloth.materials(),
+            materials: cloth.edge_materials(),
+            widths: cloth.edge_widths(),
+            states: &state.tensile,
+            hysteresis: params.hysteresis && cloth.tensile_hysteretic(),
+        });
         for pass in 0..params.collision_passes {
             let s = &mut self.s;
             let problem = ShapeProblem {
@@ -44,6 +51,7 @@ impl Solver {
                 time,
                 damping: params.damping,
                 targets: &s.target,
+                tension,
                 axial: params.axial_constraint,
                 measure: params.shear_measure,
                 shear: &s.cell_shear,
@@ -97,6 +105,7 @@ impl Solver {
             time,
             damping: params.damping,
             targets: &s.target,
+            tension,
             axial: params.axial_constraint,
             measure: params.shear_measure,
             shear: &s.cell_shear,

@@ -76,6 +76,8 @@ impl Solver {
                     0.0
                 }
             });
+            // The targets the solve ended with (for the strain diagnostics).
+            self.targets(cloth, state, params);
         }
         state.axial_force.copy_from_slice(&self.s.p);
         // The cells' shear angles at the end of the step, by the step's measure.
