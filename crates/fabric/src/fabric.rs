@@ -121,6 +121,20 @@ pub fn bias_from_shear(
     .map_err(|e| e.within("shear"))
 }
 
+/// The bias (45°) tensile loop of the yarns alone: a uniaxial force f along 45° puts f/2 on
+/// each yarn direction, `ε₄₅(f) = ½ φ_v(f/2) + ½ φ_u(f/2)` (ν ≈ 0), without the trellis shear of
+/// [`bias_from_shear`] — for a model whose cells carry the shear themselves (the solver's shear
+/// constraints, `method.md` §2b), where the fabric's own bias curve would count the shear twice.
+pub fn bias_from_yarns(warp: &TensileLoop, weft: &TensileLoop) -> Result<TensileLoop, InvalidValue> {
+    let rigid = Shear {
+        stiffness: f64::INFINITY,
+        hysteresis: 0.0,
+        hysteresis_5deg: None,
+        locking_angle: DEFAULT_LOCKING_ANGLE,
+    };
+    bias_from_shear(warp, weft, &rigid)
+}
+
 /// A fabric's mechanics in SI units.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Fabric {

@@ -132,6 +132,19 @@ fn main() {
                 run.max_strain_error,
                 run.max_axial_strain,
             );
+            let strains = state.strains(&cloth);
+            let mut idx: Vec<usize> = (0..strains.len())
+                .filter(|&e| cloth.topology().edges()[e].kind.is_axial())
+                .collect();
+            idx.sort_by(|&a, &b| strains[b].total_cmp(&strains[a]));
+            for &e in idx.iter().take(4) {
+                let ed = cloth.topology().edges()[e];
+                println!(
+                    "  edge {e} {:?} nodes {} {} (rings {} {}) strain {:.3e} force {:.3e} N",
+                    ed.kind, ed.a, ed.b, ed.a as usize / scene.n_around, ed.b as usize / scene.n_around,
+                    strains[e], state.axial_force[e]
+                );
+            }
             let prominences: Vec<String> = run
                 .measure
                 .folds

@@ -107,6 +107,9 @@ pub struct Cloth {
     fabric: Fabric,
     form: AnisotropyForm,
     materials: MaterialTable,
+    /// The same angles with the bias tensile loops of the yarns alone (no trellis shear): what
+    /// the PARTY step's axial edges read, its cells carrying the shear.
+    yarn_materials: MaterialTable,
     edge_material: Vec<u32>,
     slot_material: Vec<[u32; SLOTS]>,
     edge_width: Vec<f64>,
@@ -210,20 +213,37 @@ impl Cloth {
         } else {
             1e-3
         };
-        let (materials, edge_material) = MaterialTable::build(fabric, form, &angles)
-            .map(|(t, idx)| {
-                (
-                    t.map_tensile(|l| {
-                        l.with_linear_toe(toe * l.max_force())
-                            .with_deadband(band * l.max_force())
-                    }),
-                    idx,
-                )
-            })
-            .map_err(|source| ClothError::Material {
-                fabric: fabric.name.clone(),
-                source,
+        let build = |fabric: &Fabric| {
+            MaterialTable::build(fabric, form, &angles)
+                .map(|(t, idx)| {
+                    (
+                        t.map_tensile(|l| {
+                            l.with_linear_toe(toe * l.max_force())
+                                .with_deadband(band * l.max_force())
+                        }),
+                        idx,
+                    )
+                })
+                .map_err(|source| ClothError::Material {
+                    fabric: fabric.name.clone(),
+                    source,
+                })
+        };
+        let (materials, edge_material) = build(fabric)?;
+        let yarn_fabric = {
+            let mut f = fabric.clone();
+            let t = &f.tensile;
+            let bias = atelier_fabric::bias_from_yarns(&t.warp, &t.weft).map_err(|source| {
+                ClothError::Material {
+                    fabric: fabric.name.clone(),
+                    source,
+                }
             })?;
+            f.tensile.bias45 = bias.clone();
+            f.tensile.bias135 = bias;
+            f
+        };
+        let (yarn_materials, _) = build(&yarn_fabric)?;
         let slot_material = topology
             .axial_edges()
             .iter()
@@ -315,6 +335,7 @@ impl Cloth {
             fabric: fabric.clone(),
             form,
             materials,
+            yarn_materials,
             edge_material,
             slot_material,
             edge_width,
@@ -479,6 +500,13 @@ impl Cloth {
     /// The per-angle material table.
     pub fn materials(&self) -> &MaterialTable {
         &self.materials
+    }
+
+    /// The per-angle table with the yarns' own bias tensile loops (no trellis shear), indexed
+    /// like [`Self::materials`]: the tensile characteristics of the PARTY step's axial edges,
+    /// whose cells carry the shear (`docs/solver.md`).
+    pub fn yarn_materials(&self) -> &MaterialTable {
+        &self.yarn_materials
     }
 
     /// Material entry of each edge.

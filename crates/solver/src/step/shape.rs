@@ -36,7 +36,7 @@ impl Solver {
         let mut pressure = Duration::ZERO;
         let mut last = ShapeReport::default();
         let tension = (params.tension == Tension::Constraint).then(|| EdgeTension {
-            table: cloth.materials(),
+            table: cloth.yarn_materials(),
             materials: cloth.edge_materials(),
             widths: cloth.edge_widths(),
             states: &state.tensile,

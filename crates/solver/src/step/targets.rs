@@ -30,7 +30,7 @@ impl Solver {
         let (widths, mats, table) = (
             cloth.edge_widths(),
             cloth.edge_materials(),
-            cloth.materials(),
+            cloth.yarn_materials(),
         );
         let hysteresis = params.hysteresis && cloth.tensile_hysteretic();
         let s = &mut self.s;

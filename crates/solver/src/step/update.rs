@@ -106,7 +106,7 @@ impl Solver {
             let fpw = &self.s.force_per_width;
             for (e, st) in state.tensile.iter_mut().enumerate() {
                 if edges[e].kind.is_axial() {
-                    st.update(table.tensile(mats[e]), fpw[e]);
+                    st.update(cloth.yarn_materials().tensile(mats[e]), fpw[e]);
                 }
             }
         }
