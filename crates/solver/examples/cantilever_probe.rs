@@ -63,6 +63,7 @@ fn main() {
         let mut unconverged = 0;
         let mut result = Ok(());
         let mut vmax = 0.0;
+        let mut calm_since: Option<f64> = None;
         while state.time < get("max_time", 6.0) {
             match solver.step(&cloth, &mut state, &params) {
                 Ok(r) => {
@@ -75,13 +76,31 @@ fn main() {
                     }
                     unconverged += usize::from(!r.converged);
                     vmax = r.max_speed;
-                    if state.time > 1.0 && r.max_speed < get("rest", 1e-4) {
-                        break;
+                    if r.max_speed < get("rest", 1e-4) {
+                        let since = *calm_since.get_or_insert(state.time);
+                        if state.time - since > 0.5 {
+                            break;
+                        }
+                    } else {
+                        calm_since = None;
                     }
                 }
                 Err(e) => {
                     result = Err(e);
                     break;
+                }
+            }
+        }
+        if let Some(dt2) = args.iter().find_map(|a| a.strip_prefix("then_dt=")) {
+            let p2 = StepParams { dt: dt2.parse().expect("dt"), ..params.clone() };
+            let tip = (state.positions[2 * nv - 1] + state.positions[2 * nv - 2]) * 0.5;
+            println!("  before switch: chord {:.4}°", (-tip.z).atan2(tip.x).to_degrees());
+            let t1 = state.time;
+            while state.time < t1 + 2.0 {
+                let r = solver.step(&cloth, &mut state, &p2).expect("step");
+                let tip = (state.positions[2 * nv - 1] + state.positions[2 * nv - 2]) * 0.5;
+                if ((state.time - t1) / 0.25).fract() < p2.dt / 0.25 {
+                    println!("  t {:.3} chord {:.4}° vmax {:.2e} viol {:.1e} its {}", state.time, (-tip.z).atan2(tip.x).to_degrees(), r.max_speed, r.violation, r.shape_iterations);
                 }
             }
         }
