@@ -125,7 +125,10 @@ pub fn bias_from_shear(
 /// each yarn direction, `ε₄₅(f) = ½ φ_v(f/2) + ½ φ_u(f/2)` (ν ≈ 0), without the trellis shear of
 /// [`bias_from_shear`] — for a model whose cells carry the shear themselves (the solver's shear
 /// constraints, `method.md` §2b), where the fabric's own bias curve would count the shear twice.
-pub fn bias_from_yarns(warp: &TensileLoop, weft: &TensileLoop) -> Result<TensileLoop, InvalidValue> {
+pub fn bias_from_yarns(
+    warp: &TensileLoop,
+    weft: &TensileLoop,
+) -> Result<TensileLoop, InvalidValue> {
     let rigid = Shear {
         stiffness: f64::INFINITY,
         hysteresis: 0.0,

@@ -280,9 +280,7 @@ fn stage_medians(fixture: &Fixture, steps: usize) -> StageMedians {
         ns_per_edge_internal_iteration: median_f64(
             reports
                 .iter()
-                .map(|r| {
-                    per_edge_iteration(r.timings.internal, r.internal_iterations)
-                })
+                .map(|r| per_edge_iteration(r.timings.internal, r.internal_iterations))
                 .collect(),
         ),
         max_strain_error: reports

@@ -10,7 +10,10 @@ use nalgebra::Vector3;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let name = args.first().cloned().unwrap_or_else(|| "cotton_broad".into());
+    let name = args
+        .first()
+        .cloned()
+        .unwrap_or_else(|| "cotton_broad".into());
     let get = |key: &str, default: f64| -> f64 {
         args.iter()
             .find_map(|a| a.strip_prefix(&format!("{key}=")))
@@ -70,8 +73,15 @@ fn main() {
                     if !r.converged && get("verbose", 0.0) != 0.0 {
                         println!(
                             "  t {:.3}: viol {:.2e} {:?} shape its {} backtracks? fact {} lin {} internal {} {} bending {}",
-                            state.time, r.violation, r.worst, r.shape_iterations, r.factorizations,
-                            r.linear_iterations, r.internal_iterations, r.internal_converged, r.bending_residual
+                            state.time,
+                            r.violation,
+                            r.worst,
+                            r.shape_iterations,
+                            r.factorizations,
+                            r.linear_iterations,
+                            r.internal_iterations,
+                            r.internal_converged,
+                            r.bending_residual
                         );
                     }
                     unconverged += usize::from(!r.converged);
@@ -92,15 +102,28 @@ fn main() {
             }
         }
         if let Some(dt2) = args.iter().find_map(|a| a.strip_prefix("then_dt=")) {
-            let p2 = StepParams { dt: dt2.parse().expect("dt"), ..params.clone() };
+            let p2 = StepParams {
+                dt: dt2.parse().expect("dt"),
+                ..params.clone()
+            };
             let tip = (state.positions[2 * nv - 1] + state.positions[2 * nv - 2]) * 0.5;
-            println!("  before switch: chord {:.4}°", (-tip.z).atan2(tip.x).to_degrees());
+            println!(
+                "  before switch: chord {:.4}°",
+                (-tip.z).atan2(tip.x).to_degrees()
+            );
             let t1 = state.time;
             while state.time < t1 + 2.0 {
                 let r = solver.step(&cloth, &mut state, &p2).expect("step");
                 let tip = (state.positions[2 * nv - 1] + state.positions[2 * nv - 2]) * 0.5;
                 if ((state.time - t1) / 0.25).fract() < p2.dt / 0.25 {
-                    println!("  t {:.3} chord {:.4}° vmax {:.2e} viol {:.1e} its {}", state.time, (-tip.z).atan2(tip.x).to_degrees(), r.max_speed, r.violation, r.shape_iterations);
+                    println!(
+                        "  t {:.3} chord {:.4}° vmax {:.2e} viol {:.1e} its {}",
+                        state.time,
+                        (-tip.z).atan2(tip.x).to_degrees(),
+                        r.max_speed,
+                        r.violation,
+                        r.shape_iterations
+                    );
                 }
             }
         }

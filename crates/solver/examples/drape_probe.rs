@@ -13,7 +13,10 @@ use atelier_solver::{ShapeMethod, ShearMeasure, Solver, StepParams};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let name = args.first().cloned().unwrap_or_else(|| "polyester_faille".into());
+    let name = args
+        .first()
+        .cloned()
+        .unwrap_or_else(|| "polyester_faille".into());
     let get = |key: &str, default: f64| -> f64 {
         args.iter()
             .find_map(|a| a.strip_prefix(&format!("{key}=")))
@@ -141,8 +144,13 @@ fn main() {
                 let ed = cloth.topology().edges()[e];
                 println!(
                     "  edge {e} {:?} nodes {} {} (rings {} {}) strain {:.3e} force {:.3e} N",
-                    ed.kind, ed.a, ed.b, ed.a as usize / scene.n_around, ed.b as usize / scene.n_around,
-                    strains[e], state.axial_force[e]
+                    ed.kind,
+                    ed.a,
+                    ed.b,
+                    ed.a as usize / scene.n_around,
+                    ed.b as usize / scene.n_around,
+                    strains[e],
+                    state.axial_force[e]
                 );
             }
             let prominences: Vec<String> = run

@@ -50,17 +50,47 @@ fn main() {
     };
     let mut solver = Solver::new();
     for _ in 0..steps {
-        if let Some((e, t)) = state.axial_force.iter().enumerate().fold(None, |a: Option<(usize, f64)>, (e, &t)| match a { Some((_, b)) if b <= t => a, _ => Some((e, t)) }) {
+        if let Some((e, t)) =
+            state
+                .axial_force
+                .iter()
+                .enumerate()
+                .fold(None, |a: Option<(usize, f64)>, (e, &t)| match a {
+                    Some((_, b)) if b <= t => a,
+                    _ => Some((e, t)),
+                })
+        {
             let edge = cloth.topology().edges()[e];
-            eprintln!("  min T {t:.3e} edge {e} {:?} nodes {} {} at {:?}", edge.kind, edge.a, edge.b, state.positions[edge.a as usize]);
+            eprintln!(
+                "  min T {t:.3e} edge {e} {:?} nodes {} {} at {:?}",
+                edge.kind, edge.a, edge.b, state.positions[edge.a as usize]
+            );
         }
         match solver.step(&cloth, &mut state, &params) {
             Ok(r) => println!(
                 "target strain [{:.3e}, {:.3e}] T [{:.3e}, {:.3e}] t {:.3} conv {} viol {:.2e} {:?} its {} fact {} lin {} vmax {:.3} strain err {:.2e}",
-                solver.last_targets().iter().zip(cloth.topology().edges()).map(|(t, e)| t / e.rest_length - 1.0).fold(f64::INFINITY, f64::min),
-                solver.last_targets().iter().zip(cloth.topology().edges()).map(|(t, e)| t / e.rest_length - 1.0).fold(f64::NEG_INFINITY, f64::max),
-                state.axial_force.iter().cloned().fold(f64::INFINITY, f64::min),
-                state.axial_force.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+                solver
+                    .last_targets()
+                    .iter()
+                    .zip(cloth.topology().edges())
+                    .map(|(t, e)| t / e.rest_length - 1.0)
+                    .fold(f64::INFINITY, f64::min),
+                solver
+                    .last_targets()
+                    .iter()
+                    .zip(cloth.topology().edges())
+                    .map(|(t, e)| t / e.rest_length - 1.0)
+                    .fold(f64::NEG_INFINITY, f64::max),
+                state
+                    .axial_force
+                    .iter()
+                    .cloned()
+                    .fold(f64::INFINITY, f64::min),
+                state
+                    .axial_force
+                    .iter()
+                    .cloned()
+                    .fold(f64::NEG_INFINITY, f64::max),
                 state.time,
                 r.converged,
                 r.violation,

@@ -99,6 +99,15 @@ impl Solver {
         self.projection = projection::ShapeSolver::default();
     }
 
+    /// The force the last step's constraints (edges, cells, bending, ties) exerted on each
+    /// node, N: at a pinned node, minus the reaction its pin supplied — what a clamp measures
+    /// (the virtual KES instruments). Zero before the first step.
+    pub fn constraint_forces(&self, dt: f64) -> Vec<V3> {
+        let mut out = vec![V3::zeros(); self.s.vel.len()];
+        self.projection.node_forces(dt, &mut out);
+        out
+    }
+
     /// Rows of the shape stage's system, and the non-zeros of its lower triangle and of its
     /// factor (0 before the first step; diagnostics and benches).
     pub fn shape_system_size(&self) -> (usize, usize, usize) {
@@ -208,9 +217,8 @@ impl Solver {
             hook,
             &mut report,
         )?;
-        report.timings.shape = t0.elapsed()
-            - report.timings.collision
-            - (report.timings.pressure - pressure_before);
+        report.timings.shape =
+            t0.elapsed() - report.timings.collision - (report.timings.pressure - pressure_before);
         report.converged = report.shape_converged
             && report.internal_converged
             && report.bending_residual <= params.bending_tolerance;

@@ -26,11 +26,11 @@ use rayon::prelude::*;
 
 use atelier_fabric::{Branch, MaterialTable, TensileState};
 
+use super::{Tie, plane_push};
 use crate::cloth::Cloth;
 use crate::dual::{DualError, DualSystem, NONE, NodeWeight, Preconditioner, SLOTS};
 use crate::params::{ConstraintKind, ShapeMethod};
 use crate::shear_angle::{ShearMeasure, cell_angle_gradient};
-use super::{Tie, plane_push};
 
 type V3 = Vector3<f64>;
 
@@ -350,11 +350,7 @@ impl ShapeSolver {
         let st = self.structure.as_mut().expect("built");
         // Node weights: a group moves with its summed mass; a group with a pinned node does not
         // move at all.
-        let (inv, mass, area) = (
-            cloth.inverse_masses(),
-            cloth.masses(),
-            topo.node_areas(),
-        );
+        let (inv, mass, area) = (cloth.inverse_masses(), cloth.masses(), topo.node_areas());
         let damp = p.damping * p.dt;
         for w in st.system.weight.iter_mut() {
             *w = NodeWeight::default();
@@ -914,7 +910,11 @@ impl ShapeSolver {
                         &self.b,
                         &mut self.dl,
                         LINEAR_TOLERANCE,
-                        if fresh { LINEAR_CAP } else { refactor_after.max(1) },
+                        if fresh {
+                            LINEAR_CAP
+                        } else {
+                            refactor_after.max(1)
+                        },
                         Preconditioner::Factor,
                         Par::Seq,
                     )?;
@@ -1081,6 +1081,28 @@ impl ShapeSolver {
             for (r, kind) in st.kinds.iter().enumerate() {
                 if let RowKind::Edge(e) = kind {
                     out[*e as usize] = -self.lambda[r] / (dt * dt);
+                }
+            }
+        }
+    }
+
+    /// The force every constraint of the last solve exerted on each node, Σ_rows ∂C/∂x·λ/Δt²
+    /// (N), into `out` (one entry per node). For a pinned node this is the reaction its pin
+    /// must supply against the cloth (with the opposite sign): what a clamp of a tensile or
+    /// shear tester measures. A group of sewn nodes reports its total on its first node.
+    pub fn node_forces(&self, dt: f64, out: &mut [V3]) {
+        out.iter_mut().for_each(|f| *f = V3::zeros());
+        if let Some(st) = &self.structure {
+            for r in 0..st.kinds.len() {
+                if st.dead[r] {
+                    continue;
+                }
+                let l = self.lambda[r] / (dt * dt);
+                for k in SLOTS * r..SLOTS * (r + 1) {
+                    let node = st.system.slot_node(k);
+                    if node != NONE {
+                        out[node as usize] += st.system.grad[k] * l;
+                    }
                 }
             }
         }
@@ -1291,7 +1313,10 @@ mod tests {
                 50,
             );
             eprintln!("cheb {jacobi:?} from {start:?}");
-            assert!(jacobi.violation < start.violation, "{jacobi:?} vs {start:?}");
+            assert!(
+                jacobi.violation < start.violation,
+                "{jacobi:?} vs {start:?}"
+            );
         }
     }
 }

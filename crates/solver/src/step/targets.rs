@@ -73,9 +73,7 @@ impl Solver {
             self.s.cell_shear.clear();
             return;
         }
-        self.s
-            .cell_shear
-            .resize(cells.len(), CellShear::default());
+        self.s.cell_shear.resize(cells.len(), CellShear::default());
         let rest = cloth.cell_rest_angles(params.shear_measure);
         let (l, lock, scale) = (
             cloth.shear_loop(),
@@ -151,7 +149,8 @@ impl Solver {
                 // The local slope, by a central difference over a small part of the spindle's
                 // reversal width, within the spindle's own bounds [B, stick·B].
                 let h = 1e-3 * spindle.residual_moment() / b;
-                let slope = (st.moment(&spindle, eta + h) - st.moment(&spindle, eta - h)) / (2.0 * h);
+                let slope =
+                    (st.moment(&spindle, eta + h) - st.moment(&spindle, eta - h)) / (2.0 * h);
                 (st.moment(&spindle, eta), slope.clamp(b, stick.max(1.0) * b))
             } else {
                 (b * eta, b)

@@ -138,8 +138,7 @@ impl Solver {
                             + edges[axial_edges[i][2 * dir + 1] as usize].rest_length);
                     let nrm = self.s.node_bend[2 * i + dir].normal;
                     let (ea, eb) = (pos[i] - pos[before as usize], pos[after as usize] - pos[i]);
-                    let eta =
-                        (nrm.dot(&(eb / eb.norm())) - nrm.dot(&(ea / ea.norm()))) / l;
+                    let eta = (nrm.dot(&(eb / eb.norm())) - nrm.dot(&(ea / ea.norm()))) / l;
                     let spindle = regularised(
                         table.bending(smats[i][2 * dir]),
                         params.bending_stick_slope,
