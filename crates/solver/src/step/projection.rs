@@ -47,7 +47,7 @@ const LINEAR_CAP: usize = 50;
 
 /// The largest move of a node in one Newton step, as a fraction of its spacing (a trust
 /// region against the huge steps of a nearly singular system).
-const MAX_MOVE: f64 = 0.1;
+const MAX_MOVE: f64 = 0.5;
 
 /// Backtracking halvings of a Newton step before it is taken as it is.
 const LINE_SEARCH_HALVINGS: usize = 6;
@@ -888,6 +888,9 @@ impl ShapeSolver {
         let mut omega = 1.0;
         let (mut violation, mut worst) = self.evaluate(p, vel);
         loop {
+            if std::env::var_os("ATELIER_DEBUG").is_some() {
+                eprintln!("  it {} viol {violation:.3e} {worst:?} merit {:.3e} backtracks {}", report.iterations, self.merit, report.backtracks);
+            }
             report.violation = violation;
             report.worst = worst;
             if violation <= tol {
