@@ -230,6 +230,7 @@ pub fn simulate(spec: &StringFitSpec, base: &Path) -> Result<Simulated, RunError
         wet: None,
         fit: Some(Box::new(FitOutputs { parameters_ron })),
         comparison: None,
+        convergence: None,
     })
 }
 

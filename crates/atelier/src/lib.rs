@@ -7,6 +7,7 @@
 
 pub mod assemble;
 pub mod chart;
+pub mod convergence;
 pub mod export;
 pub mod fit;
 pub mod picture;

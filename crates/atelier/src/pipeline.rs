@@ -8,7 +8,8 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::scene::{GarmentSpec, Scene, SceneError};
+use crate::convergence::{Convergence, Tally, solvers};
+use crate::scene::{ClothSolver, GarmentSpec, Scene, SceneError};
 use crate::simulation::{Phase, Simulation, Timings};
 
 /// One recorded instant.
@@ -54,6 +55,8 @@ pub struct GarmentRun {
     pub kinetic_energy: f64,
     /// Largest kinetic energy over the motion phase, J (0 without one).
     pub max_motion_energy: f64,
+    /// Whether the steps converged (PARTY; the baselines do not report it).
+    pub convergence: Convergence,
     /// The failure that ended the run early, if any.
     pub failure: Option<String>,
     /// Things the user should know.
@@ -73,6 +76,13 @@ pub fn run_garment(
 /// [`run_garment`] on a scene already set up (the try-on builds its own body and motion).
 pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentRun, SceneError> {
     let frame_interval = scene.settings.frame_interval;
+    let baseline = match &scene.settings.solver {
+        ClothSolver::Party => None,
+        ClothSolver::Xpbd(_) => Some(solvers::XPBD),
+        ClothSolver::MassSpring(_) => Some(solvers::MASS_SPRING),
+    };
+    let tolerance = scene.settings.step.shape_tolerance;
+    let mut tally = Tally::default();
     let mut sim = Simulation::new(scene)?;
     let to3 = |v: &[atelier_collide::V3]| -> Vec<[f64; 3]> {
         v.iter().map(|p| [p.x, p.y, p.z]).collect()
@@ -97,6 +107,7 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
         max_strain_error: (0.0, 0.0),
         kinetic_energy: 0.0,
         max_motion_energy: 0.0,
+        convergence: Convergence::not_reported(solvers::PARTY, 0),
         failure: None,
         warnings: Vec::new(),
     };
@@ -104,6 +115,7 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
     let mut next_frame = frame_interval;
     let clock = Instant::now();
     loop {
+        let start_time = sim.time();
         let outcome = match sim.step() {
             Ok(Some(o)) => o,
             Ok(None) => break,
@@ -115,6 +127,9 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
         run.steps += 1;
         run.timings.add(&outcome.timings);
         let r = &outcome.report;
+        if baseline.is_none() {
+            tally.add(r, start_time, Some(outcome.phase));
+        }
         run.max_strain_error.0 = run.max_strain_error.0.max(r.max_strain_error);
         run.max_strain_error.1 = r.max_strain_error;
         run.kinetic_energy = r.kinetic_energy;
@@ -135,6 +150,10 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
     run.pairs = sim.sewing_progress();
     run.sewn_at = sim.sewn_at();
     run.warnings = sim.warnings().to_vec();
+    run.convergence = match baseline {
+        None => tally.convergence(tolerance),
+        Some(name) => Convergence::not_reported(name, run.steps),
+    };
     let last_time = run.frames.last().map_or(-1.0, |f| f.time);
     if (sim.time() - last_time).abs() > 1e-12 {
         run.frames.push(frame(&sim));

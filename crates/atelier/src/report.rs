@@ -10,6 +10,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use crate::convergence::{Convergence, UNCONVERGED_FRACTION};
 use crate::run::{RunError, Simulated, check_expectations};
 use crate::scenario::Scenario;
 
@@ -77,6 +78,9 @@ pub struct Comparison {
     pub pressure_s: f64,
     /// The failure that ended it early (`null`: none).
     pub failure: Option<String>,
+    /// Whether its steps converged (its counts `null` when its solver does not report it).
+    #[serde(default)]
+    pub convergence: Option<Convergence>,
 }
 
 /// One expectation and its outcome.
@@ -137,6 +141,10 @@ pub struct Report {
     pub warnings: Vec<String>,
     /// The failure that ended the run early (`null`: none).
     pub failure: Option<String>,
+    /// Whether the run's steps converged (`null`: no solver stepped, the string
+    /// identification; its counts `null` when the solver does not report convergence).
+    #[serde(default)]
+    pub convergence: Option<Convergence>,
     /// The files written beside the report.
     pub outputs: Vec<String>,
     /// The compared run of a wet scene (absent otherwise).
@@ -193,6 +201,7 @@ impl Report {
             expectations,
             warnings: sim.warnings.clone(),
             failure: sim.failure.clone(),
+            convergence: sim.convergence.clone(),
             outputs: Vec::new(),
             comparison: sim.comparison.clone(),
             tryon: None,
@@ -221,17 +230,40 @@ impl Report {
         })
     }
 
-    /// Whether the run succeeded: no failure and every expectation met.
+    /// Whether the run succeeded: no failure, every expectation met, every step converged
+    /// (unless the scenario bounds `unconverged_fraction` itself: then that expectation
+    /// decides) and, for a try-on, a fit that matched the silhouette.
     pub fn passed(&self) -> bool {
         self.failure.is_none()
             && self.expectations_met
+            && !self.unconverged()
             && self
                 .tryon
                 .as_ref()
                 .is_none_or(|t| t.iou_after >= crate::tryon::LOW_IOU)
     }
 
-    /// One line: name, outcome, steps and wall time, and the failure or unmet expectations.
+    /// Whether some step did not converge and the scenario does not bound
+    /// `unconverged_fraction` itself: the run's numbers are not all converged results, and
+    /// the run does not pass.
+    pub fn unconverged(&self) -> bool {
+        self.convergence
+            .as_ref()
+            .is_some_and(Convergence::any_unconverged)
+            && !self
+                .expectations
+                .iter()
+                .any(|e| e.metric == UNCONVERGED_FRACTION)
+    }
+
+    /// The warning about the run's unconverged steps, if some step did not converge.
+    pub fn convergence_warning(&self) -> Option<String> {
+        self.convergence.as_ref().and_then(Convergence::warning)
+    }
+
+    /// One line: name, outcome, steps and wall time, and the failure, the unmet expectations
+    /// or the steps that did not converge (`ok`, `FAILED`, `EXPECTATION NOT MET`, `NOT
+    /// CONVERGED`).
     pub fn summary_line(&self) -> String {
         let head = format!(
             "{}: {} steps, {:.2} s simulated in {:.2} s wall",
@@ -261,10 +293,17 @@ impl Report {
                 format!("{} = {value} not {bound}", e.metric)
             })
             .collect();
-        if unmet.is_empty() {
-            format!("ok {head}")
-        } else {
-            format!("EXPECTATION NOT MET {head}: {}", unmet.join("; "))
+        let unconverged = self
+            .unconverged()
+            .then(|| self.convergence_warning())
+            .flatten();
+        match (unmet.is_empty(), unconverged) {
+            (true, None) => format!("ok {head}"),
+            (true, Some(w)) => format!("NOT CONVERGED {head}: {w}"),
+            (false, None) => format!("EXPECTATION NOT MET {head}: {}", unmet.join("; ")),
+            (false, Some(w)) => {
+                format!("EXPECTATION NOT MET {head}: {}; {w}", unmet.join("; "))
+            }
         }
     }
 }

@@ -22,6 +22,7 @@ use atelier_solver::scenes::DrapeScene;
 use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
 use nalgebra::Vector3;
 
+use crate::convergence::{Convergence, Tally, UNCONVERGED_FRACTION, solvers};
 use crate::export::{
     Animation, ExportError, FrameSelection, GlbOptions, MeshPart, write_glb, write_obj, write_ply,
 };
@@ -98,6 +99,8 @@ pub struct Simulated {
     pub fit: Option<Box<crate::fit::FitOutputs>>,
     /// The compared run of a wet scene.
     pub comparison: Option<crate::report::Comparison>,
+    /// Whether the steps converged (`None`: no solver stepped, the string identification).
+    pub convergence: Option<Convergence>,
 }
 
 /// Options of [`run`].
@@ -502,6 +505,11 @@ fn finish_simulated(sim: &mut Simulated) {
         .insert("simulated_s".into(), Some(sim.simulated));
     sim.metrics
         .insert("frames".into(), Some(sim.cloth.frames.len() as f64));
+    if let Some(c) = &sim.convergence {
+        sim.metrics
+            .insert(UNCONVERGED_FRACTION.into(), c.unconverged_fraction());
+        sim.warnings.extend(c.warning());
+    }
 }
 
 fn node_count(sim: &Simulated) -> usize {
@@ -629,6 +637,7 @@ fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
         wet: None,
         fit: None,
         comparison: None,
+        convergence: Some(run.convergence),
     }
 }
 
@@ -648,6 +657,9 @@ struct Stepper {
     max_speed: f64,
     failure: Option<String>,
     last_good: Vec<Vector3<f64>>,
+    tally: Tally,
+    /// The shape tolerance of the steps.
+    tolerance: f64,
 }
 
 impl Stepper {
@@ -665,6 +677,8 @@ impl Stepper {
             max_speed: 0.0,
             failure: None,
             last_good: state.positions.clone(),
+            tally: Tally::default(),
+            tolerance: StepParams::default().shape_tolerance,
         }
     }
 
@@ -684,6 +698,8 @@ impl Stepper {
         match result {
             Ok(r) => {
                 self.steps += 1;
+                self.tally.add(&r, t, None);
+                self.tolerance = params.shape_tolerance;
                 self.timings.add(&Timings {
                     solver: r.timings,
                     ..Timings::default()
@@ -751,6 +767,7 @@ impl Stepper {
             wet: None,
             fit: None,
             comparison: None,
+            convergence: Some(self.tally.convergence(self.tolerance)),
         }
     }
 }
@@ -1307,5 +1324,7 @@ fn kes_simulated(
         wet: None,
         fit: None,
         comparison: None,
+        // `atelier_solver::kes` does not hand out its steps' reports (yet): not reported.
+        convergence: Some(Convergence::not_reported(solvers::PARTY, steps)),
     })
 }

@@ -97,7 +97,8 @@ impl ScenarioKind {
     }
 
     /// The metrics a run of this kind reports (the names expectations may use). Units are in the
-    /// names; `docs/report.md` defines each.
+    /// names; `docs/report.md` defines each. Every kind that steps a cloth reports
+    /// `unconverged_fraction` (`null` when its solver does not report convergence).
     pub fn metric_names(&self) -> &'static [&'static str] {
         match self {
             ScenarioKind::Wet(_) => crate::wet::METRICS,
@@ -118,7 +119,9 @@ impl ScenarioKind {
                 "kinetic_energy_j",
                 "max_motion_kinetic_energy_j",
                 "lowest_node_m",
+                "nodes_below_body",
                 "frames",
+                crate::convergence::UNCONVERGED_FRACTION,
             ],
             ScenarioKind::Drape(_) => &[
                 "nodes",
@@ -134,6 +137,7 @@ impl ScenarioKind {
                 "max_strain_error",
                 "kinetic_energy_j",
                 "frames",
+                crate::convergence::UNCONVERGED_FRACTION,
             ],
             ScenarioKind::Cantilever(_) => &[
                 "nodes",
@@ -148,6 +152,7 @@ impl ScenarioKind {
                 "max_strain_error",
                 "kinetic_energy_j",
                 "frames",
+                crate::convergence::UNCONVERGED_FRACTION,
             ],
             ScenarioKind::Catenary(_) => &[
                 "nodes",
@@ -161,6 +166,7 @@ impl ScenarioKind {
                 "max_strain_error",
                 "kinetic_energy_j",
                 "frames",
+                crate::convergence::UNCONVERGED_FRACTION,
             ],
             ScenarioKind::KesTensile(_) => &[
                 "nodes",
@@ -177,6 +183,7 @@ impl ScenarioKind {
                 "largest_relative_error",
                 "kinetic_energy_j",
                 "frames",
+                crate::convergence::UNCONVERGED_FRACTION,
             ],
             ScenarioKind::KesBending(_) => &[
                 "nodes",
@@ -189,6 +196,7 @@ impl ScenarioKind {
                 "largest_relative_error",
                 "kinetic_energy_j",
                 "frames",
+                crate::convergence::UNCONVERGED_FRACTION,
             ],
         }
     }

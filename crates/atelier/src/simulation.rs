@@ -110,7 +110,10 @@ pub enum Failure {
 pub struct StepOutcome {
     /// The phase of the step.
     pub phase: Phase,
-    /// The solver's diagnostics.
+    /// The solver's diagnostics. A baseline solver (`settings.solver` XPBD or mass-spring)
+    /// fills in its iterations, strain, energy, speed and timings only: it has no tolerance,
+    /// so its `converged`, `shape_converged`, `violation` and `worst` say nothing (the run's
+    /// convergence is not reported, `crate::convergence`).
     pub report: StepReport,
     /// Nodes inside the body after the step.
     pub inside: usize,

@@ -14,6 +14,7 @@ use atelier_solver::wet::scene::{WetRun, WetScene, WetSolver, run};
 use serde::{Deserialize, Serialize};
 
 use crate::chart::{Chart, Series};
+use crate::convergence::{Convergence, UNCONVERGED_FRACTION};
 use crate::export::Animation;
 use crate::report::Comparison;
 use crate::run::{RunError, Simulated};
@@ -86,6 +87,7 @@ pub const METRICS: &[&str] = &[
     "compare_lifted_area_cm2",
     "compare_folds",
     "rms_difference_mm",
+    UNCONVERGED_FRACTION,
 ];
 
 /// What a wet run adds to the usual outputs: the series, charts and the compared run's final
@@ -102,6 +104,13 @@ pub struct WetOutputs {
     pub compare_z_up: Option<Vec<[f64; 3]>>,
     /// Side of the square cloth, m.
     pub size: f64,
+}
+
+/// Whether a run's steps converged. Yamada's model has no tolerance (a baseline); the PARTY
+/// runs of `atelier_solver::wet::scene::run` do not hand out their steps' reports (yet): both
+/// are not reported (`null`).
+fn convergence(r: &WetRun) -> Convergence {
+    Convergence::not_reported(r.solver, r.steps)
 }
 
 /// The metrics of one run (without the `compare_` ones).
@@ -240,6 +249,10 @@ pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> 
             "rms_difference_mm".into(),
             (!failed && main.failure.is_none()).then(|| main.rms_distance(c) * 1e3),
         );
+        let c_convergence = convergence(c);
+        if let Some(w) = c_convergence.warning() {
+            warnings.push(format!("the compared {} run: {w}", c.solver));
+        }
         if let Some(f) = &c.failure {
             warnings.push(format!(
                 "the compared {} run stopped at t = {:.3} s: {}",
@@ -254,6 +267,7 @@ pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> 
             wall_s: c.wall.as_secs_f64(),
             pressure_s: c.pressure_wall.as_secs_f64(),
             failure: c.failure.as_ref().map(|f| f.error.to_string()),
+            convergence: Some(c_convergence),
         });
     }
     let charts = charts(&main, compared.as_ref());
@@ -290,6 +304,7 @@ pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> 
         wet: Some(Box::new(wet)),
         fit: None,
         comparison,
+        convergence: Some(convergence(&main)),
     })
 }
 

@@ -1,6 +1,7 @@
 //! The `atelier` program: `validate` (success, a bad file, a missing file) and `run` (success,
-//! a bad file, a missing file, an unwritable folder, a diverging run, an interrupted run,
-//! determinism, the default scenario) — exit codes, one-line errors, the files written.
+//! a bad file, a missing file, an unwritable folder, a diverging run, a run whose steps do not
+//! converge, an interrupted run, determinism, the default scenario) — exit codes, one-line
+//! errors, the files written.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -199,6 +200,65 @@ fn run_writes_the_report_and_outputs_and_succeeds() {
     let json_len = u32::from_le_bytes(glb[12..16].try_into().expect("4 bytes")) as usize;
     let json = String::from_utf8_lossy(&glb[20..20 + json_len]);
     assert_eq!(json.matches("frame ").count(), 2, "two morph targets");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A small drape whose solver cannot converge (one shape iteration per pass against 1e-9), with
+/// `extra` expectations.
+fn unconverged_drape_scenario(extra: &str) -> String {
+    format!(
+        r#"(
+    name: "cli_unconverged",
+    reproduces: "a drape whose steps cannot converge (CLI test)",
+    kind: Drape(fabric: "{}", tester: Jis, n_around: 24, n_rings: 4, dt: 0.002, max_time: 0.1,
+        until_rest: false, step: (shape_max_iterations: 1, shape_tolerance: 1e-9)),
+    expectations: [{extra}],
+)"#,
+        fabric_path()
+    )
+}
+
+/// Steps that did not converge make the run fail as a doubtful result does (the try-on's low
+/// overlap): exit status 2, one line on stderr naming them, the report written with the
+/// warning. A scenario that bounds `unconverged_fraction` itself decides: within the bound exit
+/// 0, the summary on stdout and the warning on stderr.
+#[test]
+fn a_run_whose_steps_do_not_converge_exits_2_and_says_so() {
+    let dir = temp_dir("unconverged");
+    let file = write(&dir, "u.ron", &unconverged_drape_scenario(""));
+    let out = dir.join("out");
+    let (code, stdout, err) = status(&["run", s(&file), "--out", s(&out)]);
+    no_panic(&err);
+    assert_eq!(code, Some(2), "{stdout}{err}");
+    assert!(stdout.is_empty(), "{stdout}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("atelier: NOT CONVERGED cli_unconverged: 50 steps")
+            && err.contains("did not converge")
+            && err.contains("not converged results"),
+        "{err}"
+    );
+    let r = report(&out);
+    assert!(!r.passed());
+    assert!(r.convergence.as_ref().and_then(|c| c.unconverged_steps) > Some(0));
+    assert!(r.warnings.iter().any(|w| w.contains("did not converge")));
+
+    let file = write(
+        &dir,
+        "a.ron",
+        &unconverged_drape_scenario(r#"(metric: "unconverged_fraction", max: 1.0)"#),
+    );
+    let (code, stdout, err) = status(&["run", s(&file), "--out", s(&out)]);
+    assert_eq!(code, Some(0), "{stdout}{err}");
+    assert!(
+        stdout.starts_with("ok cli_unconverged: 50 steps"),
+        "{stdout}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("atelier: warning: ") && err.contains("did not converge"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

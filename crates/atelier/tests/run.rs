@@ -329,6 +329,15 @@ fn a_wet_run_reports_both_solvers_and_writes_its_series() {
     let c = report.comparison.as_ref().expect("comparison");
     assert_eq!(c.solver, "yamada");
     assert!((c.simulated_s - 0.3).abs() < 1e-6 && c.failure.is_none());
+    // Convergence: the main run's on PARTY; Yamada's model has none to report (null, not 0).
+    let main = report.convergence.as_ref().expect("convergence");
+    assert_eq!((main.solver.as_str(), main.steps), ("party", report.steps));
+    let yamada = c
+        .convergence
+        .as_ref()
+        .expect("the compared run's convergence");
+    assert_eq!((yamada.solver.as_str(), yamada.steps), ("yamada", c.steps));
+    assert!(yamada.unconverged_steps.is_none() && yamada.max_violation.is_none());
     for name in [
         outputs::PICTURE,
         outputs::COMPARE,
@@ -410,4 +419,246 @@ fn a_string_fit_reports_its_errors_and_writes_its_parameters() {
     .expect_err("no initial values");
     assert!(e.to_string().contains("initial"), "{e}");
     std::fs::remove_dir_all(&out).ok();
+}
+
+// ---- convergence (issue 21) ----------------------------------------------------------------
+
+/// The kinds of constraint a step can name as its worst.
+const CONSTRAINTS: [&str; 5] = ["edge", "cell", "bend", "tie", "plane"];
+
+/// `small_drape` with `extra` expectations before its own.
+fn small_drape_expecting(step: &str, extra: &str) -> String {
+    small_drape(step).replace("expectations: [", &format!("expectations: [{extra}, "))
+}
+
+/// A solver that cannot converge — one shape iteration per pass against a tolerance of 1e-9 —
+/// is reported: every step counted in `convergence`, the largest violation and where it was,
+/// the metric `unconverged_fraction`, a warning that says the numbers are not converged
+/// results, and the run does not pass (`NOT CONVERGED`), all of it in the written report.
+#[test]
+fn a_run_that_cannot_converge_reports_its_unconverged_steps_and_warns() {
+    let out = temp_dir("unconverged");
+    let report = run_text(
+        &small_drape("shape_max_iterations: 1, shape_tolerance: 1e-9"),
+        &out,
+    );
+    assert!(report.failure.is_none(), "{:?}", report.failure);
+    let c = report.convergence.as_ref().expect("convergence reported");
+    assert_eq!(c.solver, "party");
+    assert_eq!(c.steps, report.steps);
+    assert_eq!(c.steps, 150);
+    let unconverged = c.unconverged_steps.expect("counted");
+    let shape = c.shape_unconverged_steps.expect("counted");
+    assert!(unconverged > 0 && unconverged <= c.steps, "{c:?}");
+    assert!(shape > 0 && shape <= unconverged, "{c:?}");
+    assert_eq!(c.tolerance, Some(1e-9));
+    let largest = c.max_violation.expect("measured");
+    assert!(largest > 1e-9 && largest.is_finite(), "{c:?}");
+    let worst = c.worst.as_ref().expect("the worst step");
+    assert!(
+        CONSTRAINTS.contains(&worst.constraint.as_str()),
+        "{worst:?}"
+    );
+    assert_eq!(worst.violation.to_bits(), largest.to_bits());
+    assert!(worst.time_s >= 0.0 && worst.time_s < report.simulated_s);
+    assert!(worst.phase.is_none(), "a drape has no phases");
+    let fraction = report.metrics["unconverged_fraction"].expect("measured");
+    assert!((fraction - unconverged as f64 / c.steps as f64).abs() < 1e-15);
+    let warning = report
+        .warnings
+        .iter()
+        .find(|w| w.contains("did not converge"))
+        .expect("a warning");
+    assert!(
+        warning.starts_with(&format!("{unconverged} of 150 party steps"))
+            && warning.contains("above the shape tolerance 1e-9")
+            && warning.ends_with("numbers from those steps are not converged results"),
+        "{warning}"
+    );
+    assert_eq!(report.convergence_warning().as_ref(), Some(warning));
+    // The drape's own expectation is met; the run does not pass all the same.
+    assert!(report.expectations_met);
+    assert!(report.unconverged() && !report.passed());
+    let line = report.summary_line();
+    assert!(
+        line.starts_with("NOT CONVERGED small_drape: 150 steps") && line.contains(warning),
+        "{line}"
+    );
+    // The written report holds the same.
+    let written = std::fs::read_to_string(out.join(outputs::REPORT)).expect("report");
+    for field in [
+        "\"convergence\"",
+        "\"unconverged_steps\"",
+        "\"shape_unconverged_steps\"",
+        "\"max_violation\"",
+        "\"tolerance\"",
+        "\"worst\"",
+        "\"unconverged_fraction\"",
+    ] {
+        assert!(written.contains(field), "{field} missing");
+    }
+    assert_eq!(Report::from_json(&written).expect("parses"), report);
+    std::fs::remove_dir_all(&out).ok();
+}
+
+/// A scenario that bounds `unconverged_fraction` itself decides: within the bound the run
+/// passes (the warning stays), beyond it the expectation is not met.
+#[test]
+fn a_scenario_bounding_unconverged_fraction_decides_whether_the_run_passes() {
+    let step = "shape_max_iterations: 1, shape_tolerance: 1e-9";
+    let out = temp_dir("unconverged-accepted");
+    let accepted = run_text(
+        &small_drape_expecting(step, r#"(metric: "unconverged_fraction", max: 1.0)"#),
+        &out,
+    );
+    assert!(accepted.convergence_warning().is_some());
+    assert!(
+        accepted
+            .warnings
+            .iter()
+            .any(|w| w.contains("did not converge")),
+        "{:?}",
+        accepted.warnings
+    );
+    assert!(!accepted.unconverged());
+    assert!(accepted.passed(), "{}", accepted.summary_line());
+    assert!(accepted.summary_line().starts_with("ok small_drape"));
+    let refused = run_text(
+        &small_drape_expecting(step, r#"(metric: "unconverged_fraction", max: 0.01)"#),
+        &out,
+    );
+    assert!(!refused.expectations[0].met, "{:?}", refused.expectations);
+    assert!(!refused.passed());
+    assert!(
+        refused
+            .summary_line()
+            .starts_with("EXPECTATION NOT MET small_drape")
+            && refused.summary_line().contains("unconverged_fraction = "),
+        "{}",
+        refused.summary_line()
+    );
+    std::fs::remove_dir_all(&out).ok();
+}
+
+/// A normal quick run converges: zero unconverged steps, its largest violation within the
+/// tolerance, no warning, `unconverged_fraction` 0, and it passes.
+#[test]
+fn a_converged_run_reports_zero_unconverged_steps_and_no_warning() {
+    let out = temp_dir("converged");
+    let report = run_text(
+        &small_drape_expecting("", r#"(metric: "unconverged_fraction", max: 0.0)"#),
+        &out,
+    );
+    let c = report.convergence.as_ref().expect("convergence reported");
+    assert_eq!((c.solver.as_str(), c.steps), ("party", report.steps));
+    assert_eq!(c.unconverged_steps, Some(0), "{c:?}");
+    assert_eq!(c.shape_unconverged_steps, Some(0), "{c:?}");
+    assert_eq!(c.tolerance, Some(1e-4));
+    let largest = c.max_violation.expect("measured");
+    assert!((0.0..=1e-4).contains(&largest), "{largest}");
+    assert_eq!(report.metrics["unconverged_fraction"], Some(0.0));
+    assert!(report.convergence_warning().is_none());
+    assert!(
+        !report.warnings.iter().any(|w| w.contains("converge")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(report.passed(), "{}", report.summary_line());
+    std::fs::remove_dir_all(&out).ok();
+}
+
+/// A garment run counts its steps through the phases: the worst step names its phase, and a
+/// run with unconverged steps warns and does not pass (whatever else happened to it).
+#[test]
+fn a_garment_run_reports_its_convergence_with_the_phase() {
+    let out = temp_dir("garment-convergence");
+    let report = run_text(&short_skirt(0.05), &out);
+    let c = report.convergence.as_ref().expect("convergence reported");
+    assert_eq!((c.solver.as_str(), c.steps), ("party", report.steps));
+    assert_eq!(c.tolerance, Some(1e-4));
+    let unconverged = c.unconverged_steps.expect("counted");
+    assert!(c.shape_unconverged_steps.expect("counted") <= unconverged);
+    assert!(c.max_violation.is_some_and(|v| v >= 0.0), "{c:?}");
+    if let Some(w) = &c.worst {
+        assert!(CONSTRAINTS.contains(&w.constraint.as_str()), "{w:?}");
+        assert_eq!(w.phase.as_deref(), Some("Sewing"), "{w:?}");
+    }
+    assert_eq!(
+        report.metrics["unconverged_fraction"],
+        Some(unconverged as f64 / c.steps as f64)
+    );
+    let warned = report
+        .warnings
+        .iter()
+        .any(|w| w.contains("did not converge"));
+    assert_eq!(warned, unconverged > 0, "{:?}", report.warnings);
+    if unconverged > 0 {
+        assert!(!report.passed());
+    }
+    std::fs::remove_dir_all(&out).ok();
+}
+
+/// A baseline has no tolerance to meet: its convergence is `null`, not 0 (the solver and its
+/// steps are given), so is `unconverged_fraction`, and an expectation on it is never met.
+#[test]
+fn a_baseline_run_does_not_report_convergence() {
+    let text = short_skirt(0.05)
+        .replace(
+            "settings: (sew_limit: 0.05,",
+            "settings: (solver: Xpbd(substeps: 10), sew_limit: 0.05,",
+        )
+        .replace(
+            "expectations: [",
+            r#"expectations: [(metric: "unconverged_fraction", max: 1.0), "#,
+        );
+    assert!(text.contains("Xpbd"));
+    let out = temp_dir("baseline-convergence");
+    let report = run_text(&text, &out);
+    let c = report.convergence.as_ref().expect("convergence given");
+    assert_eq!((c.solver.as_str(), c.steps), ("xpbd", report.steps));
+    assert!(c.steps > 0);
+    assert_eq!(
+        (
+            c.unconverged_steps,
+            c.shape_unconverged_steps,
+            c.max_violation,
+            c.tolerance,
+            &c.worst
+        ),
+        (None, None, None, None, &None)
+    );
+    assert_eq!(report.metrics["unconverged_fraction"], None);
+    assert!(!report.expectations[0].met && report.expectations[0].value.is_none());
+    assert!(report.convergence_warning().is_none() && !report.unconverged());
+    let written = std::fs::read_to_string(out.join(outputs::REPORT)).expect("report");
+    assert!(
+        written.contains("\"unconverged_steps\": null"),
+        "null, not 0"
+    );
+    std::fs::remove_dir_all(&out).ok();
+}
+
+/// `unconverged_fraction` is a metric of every kind that steps a cloth (`atelier validate`
+/// accepts an expectation on it) and not of the string identification.
+#[test]
+fn unconverged_fraction_is_a_metric_of_every_kind_that_steps_a_cloth() {
+    let dir = root().join("fixtures/scenarios");
+    for entry in std::fs::read_dir(&dir).expect("scenarios") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_none_or(|e| e != "ron") {
+            continue;
+        }
+        let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let listed = s.kind.metric_names().contains(&"unconverged_fraction");
+        assert_eq!(listed, s.kind.name() != "StringFit", "{}", path.display());
+    }
+    Scenario::parse(
+        &small_drape_expecting("", r#"(metric: "unconverged_fraction", max: 0.01)"#),
+        Path::new("d.ron"),
+    )
+    .expect("a drape may bound it");
+    let fit = r#"(name: "f", reproduces: "test", kind: StringFit(observations: Synthetic(Rubber), observed: 4),
+        expectations: [(metric: "unconverged_fraction", max: 0.01)])"#;
+    let e = Scenario::parse(fit, Path::new("f.ron")).expect_err("no solver steps");
+    assert_eq!(e.field, "expectations[0].metric", "{e}");
 }

@@ -307,7 +307,13 @@ fn tryon(inputs: &atelier::tryon::TryonInputs, out: &Path, options: Options) -> 
                 out.display()
             );
             if !report.passed() {
-                for w in &report.warnings {
+                // The convergence warning is printed by `finish` (or is in the summary line).
+                let convergence = report.convergence_warning();
+                for w in report
+                    .warnings
+                    .iter()
+                    .filter(|w| Some(*w) != convergence.as_ref())
+                {
                     eprintln!("atelier: warning: {w}");
                 }
             }
@@ -340,7 +346,15 @@ fn start(options: Options) -> Result<RunOptions, ExitCode> {
 }
 
 /// The summary `line` on stdout and exit status 0 when the run passed; on stderr and 2 when not.
+/// Steps that did not converge are always said on stderr: in the summary line when they make
+/// the run fail, as a warning line before it when the scenario accepts them (it bounds
+/// `unconverged_fraction` itself) or when the run failed for another reason.
 fn finish(report: &atelier::report::Report, line: &str) -> ExitCode {
+    if let Some(w) = report.convergence_warning()
+        && !line.contains(&w)
+    {
+        eprintln!("atelier: warning: {w}");
+    }
     if report.passed() {
         // The summary is the program's output.
         #[allow(clippy::print_stdout)]
