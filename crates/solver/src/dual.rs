@@ -135,6 +135,10 @@ pub struct DualSystem {
     pub extra: Vec<f64>,
     /// Each node's weight (set by the caller).
     pub weight: Vec<NodeWeight>,
+    /// Each row's scale (its violation is its residual over this; 1 by default): the
+    /// conjugate gradients stop on the residual measured in these units, so that rows in
+    /// metres and rows in radians are solved to the same relative accuracy.
+    pub row_scale: Vec<f64>,
     // CG scratch.
     d: Vec<f64>,
     u: Vec<V3>,
@@ -251,6 +255,7 @@ impl DualSystem {
             grad: vec![V3::zeros(); slots],
             extra: vec![0.0; m],
             weight: vec![NodeWeight::default(); nodes],
+            row_scale: vec![1.0; m],
             d: vec![0.0; m],
             u: vec![V3::zeros(); nodes],
             r: vec![0.0; m],
@@ -260,9 +265,14 @@ impl DualSystem {
         })
     }
 
-    /// The gradients and extras to fill, beside the node weights (split borrows).
-    pub fn rows_mut(&mut self) -> (&mut [V3], &mut [f64], &[NodeWeight]) {
-        (&mut self.grad, &mut self.extra, &self.weight)
+    /// The gradients, extras and row scales to fill, beside the node weights (split borrows).
+    pub fn rows_mut(&mut self) -> (&mut [V3], &mut [f64], &[NodeWeight], &mut [f64]) {
+        (
+            &mut self.grad,
+            &mut self.extra,
+            &self.weight,
+            &mut self.row_scale,
+        )
     }
 
     /// Number of rows.
@@ -387,6 +397,14 @@ impl DualSystem {
         &self.u
     }
 
+    /// `Jᵀx` at node `i` (no weight): the force the rows' multipliers `x` exert on it.
+    pub fn jt_at(&self, x: &[f64], i: usize) -> V3 {
+        self.node_slot[self.node_ptr[i] as usize..self.node_ptr[i + 1] as usize]
+            .iter()
+            .map(|&s| self.grad[s as usize] * x[s as usize / SLOTS])
+            .sum()
+    }
+
     fn w_jt(
         node_ptr: &[u32],
         node_slot: &[u32],
@@ -474,7 +492,7 @@ impl DualSystem {
 
     /// Solve (J W Jᵀ + diag(extra)) x = b by conjugate gradients with `pre`conditioning (the
     /// last factorization, made first when there is none; or the diagonal), to
-    /// `‖r‖ ≤ tol·‖b‖` or `max_iterations`. `x` is overwritten (the iteration starts from 0).
+    /// `‖r‖ ≤ tol·‖b‖` in the rows' scales or `max_iterations`. `x` is overwritten (the iteration starts from 0).
     pub fn solve(
         &mut self,
         b: &[f64],
@@ -499,7 +517,14 @@ impl DualSystem {
         };
         let dot = |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).map(|(x, y)| x * y).sum() };
         x.iter_mut().for_each(|v| *v = 0.0);
-        let b_norm = dot(b, b).sqrt();
+        let scaled = |v: &[f64], scale: &[f64]| -> f64 {
+            v.iter()
+                .zip(scale)
+                .map(|(x, s)| (x / s) * (x / s))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let b_norm = scaled(b, &self.row_scale);
         if b_norm == 0.0 {
             return Ok(SolveStats::default());
         }
@@ -527,7 +552,7 @@ impl DualSystem {
                 x[k] += alpha * p[k];
                 r[k] -= alpha * q[k];
             }
-            stats.relative_residual = dot(&r, &r).sqrt() / b_norm;
+            stats.relative_residual = scaled(&r, &self.row_scale) / b_norm;
             if stats.relative_residual <= tol {
                 break;
             }

@@ -52,6 +52,10 @@ const MAX_MOVE: f64 = 0.5;
 /// Backtracking halvings of a Newton step before it is taken as it is.
 const LINE_SEARCH_HALVINGS: usize = 6;
 
+/// Compliance of a seam being drawn together, as a fraction of its own stiffness (see the
+/// tie rows in `evaluate`).
+const TIE_COMPLIANCE: f64 = 0.01;
+
 /// Relative regularisation of hard rows (a compliance this small against the row's own
 /// stiffness changes a converged length by ~1e-12 of the correction).
 const HARD_REGULARISATION: f64 = 1e-12;
@@ -216,6 +220,10 @@ struct Structure {
     dead: Vec<bool>,
     /// Rows dead by the structure alone.
     collapsed: Vec<bool>,
+    /// Edge rows that only resist stretching this step: an edge whose two nodes a tie draws
+    /// together (a dart closing at its apex gathers the cloth between the legs; held at its
+    /// length the edge would make the tie unattainable).
+    gathered: Vec<bool>,
     /// Jacobi scaling: 1 / the largest row count over the row's nodes.
     local_scale: Vec<f64>,
     /// Rows in colours sharing no node (Gauss–Seidel), built on first use.
@@ -258,6 +266,9 @@ pub struct ShapeSolver {
     shift: Vec<V3>,
     /// Σ violation² of the last evaluation (the line search's merit).
     merit: f64,
+    /// Nodes held on their contact plane in the Newton system (their weight projected onto
+    /// the plane), per root node.
+    on_plane: Vec<bool>,
     /// Symbolic analyses made (diagnostics).
     pub analyses: usize,
 }
@@ -330,7 +341,7 @@ impl ShapeSolver {
             if t.length > 0.0 {
                 let (a, b) = (self.root[t.a as usize], self.root[t.b as usize]);
                 if a != b {
-                    self.open_ties.push((a.min(b), a.max(b)));
+                    self.open_ties.push((a, b));
                     self.open_tie_index.push(k as u32);
                 }
             }
@@ -378,6 +389,7 @@ impl ShapeSolver {
                     .all(|&k| weight[k as usize].w == 0.0);
         }
         let rows = st.kinds.len();
+        self.on_plane.clear();
         // The multipliers start at zero every step (XPBD); a warm start from the last step's
         // forces was tried and measured: it saved no iterations on the drape (6.2 per step
         // either way) and cost them on cotton (10 against 6.1).
@@ -472,6 +484,23 @@ impl ShapeSolver {
             }
         }
         let system = DualSystem::new(n, &rows)?;
+        let tied: std::collections::HashSet<(u32, u32)> = self
+            .open_ties
+            .iter()
+            .map(|&(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        let edges = topo.edges();
+        let gathered: Vec<bool> = kinds
+            .iter()
+            .map(|k| match k {
+                RowKind::Edge(e) => {
+                    let edge = &edges[*e as usize];
+                    let (a, b) = (root[edge.a as usize], root[edge.b as usize]);
+                    tied.contains(&(a.min(b), a.max(b)))
+                }
+                _ => false,
+            })
+            .collect();
         // Row counts per node for the Jacobi scaling.
         let mut count = vec![0u32; n];
         for (r, nodes) in rows.iter().enumerate() {
@@ -500,6 +529,7 @@ impl ShapeSolver {
             corner_slot,
             row_nodes: rows,
             collapsed: dead.clone(),
+            gathered,
             dead,
             local_scale,
             colours: Vec::new(),
@@ -559,15 +589,20 @@ impl ShapeSolver {
         let pred = &self.pred;
         let topo = p.cloth.topology();
         let (edges, cells) = (topo.edges(), topo.cells());
-        let (kinds, corner_slot, dead, row_nodes) =
-            (&st.kinds, &st.corner_slot, &st.dead, &st.row_nodes);
-        let (grad, extras, weight) = st.system.rows_mut();
+        let (kinds, corner_slot, dead, row_nodes, gathered) = (
+            &st.kinds,
+            &st.corner_slot,
+            &st.dead,
+            &st.row_nodes,
+            &st.gathered,
+        );
+        let (grad, extras, weight, scales) = st.system.rows_mut();
         let spacing = &self.spacing;
         let (ties, tie_index, lambda) = (p.ties, &self.open_tie_index, &self.lambda);
         let dt2 = dt * dt;
-        let row = |(r, ((((g, c), extra), b), viol)): (
+        let row = |(r, ((((g, c), (extra, row_scale)), b), viol)): (
             usize,
-            ((((&mut [V3], &mut f64), &mut f64), &mut f64), &mut f64),
+            ((((&mut [V3], &mut f64), (&mut f64, &mut f64)), &mut f64), &mut f64),
         )| {
             for gk in g.iter_mut() {
                 *gk = V3::zeros();
@@ -604,7 +639,7 @@ impl ShapeSolver {
                     (
                         l - target,
                         compliance,
-                        p.axial == ConstraintKind::StretchOnly,
+                        p.axial == ConstraintKind::StretchOnly || gathered[r],
                         l0,
                         false,
                     )
@@ -618,7 +653,7 @@ impl ShapeSolver {
                     for k in 0..4 {
                         g[slot[k] as usize] -= grad[k];
                     }
-                    if gamma.abs() > sh.lock {
+                    if gamma.abs() > sh.lock && std::env::var_os("ATELIER_NOLOCK").is_none() {
                         (gamma - sh.lock.copysign(gamma), 0.0, false, 1.0, false)
                     } else {
                         (gamma - sh.offset, sh.compliance / dt2, false, 1.0, true)
@@ -656,9 +691,27 @@ impl ShapeSolver {
                     let n = if l > 0.0 { d / l } else { V3::zeros() };
                     g[slot[0] as usize] -= n;
                     g[slot[1] as usize] += n;
-                    (l - tie.length, 0.0, true, spacing[tie.a as usize], false)
+                    // A seam being drawn together is a stiff spring, not a hard constraint:
+                    // its compliance is TIE_COMPLIANCE of its own stiffness w_a + w_b, so a
+                    // tie the cloth cannot follow this step (a dart closing only by buckling
+                    // out of a flat panel, which a linearisation at the flat state cannot see)
+                    // converges to the pull the cloth allows instead of stalling the solve; a
+                    // free tie closes to within ~1 % of its gap per step, and the sewing hook
+                    // draws it again the next.
+                    let (wa, wb) = (
+                        weight[row_nodes[r][slot[0] as usize] as usize].w,
+                        weight[row_nodes[r][slot[1] as usize] as usize].w,
+                    );
+                    (
+                        l - tie.length,
+                        TIE_COMPLIANCE * (wa + wb),
+                        true,
+                        spacing[tie.a as usize],
+                        true,
+                    )
                 }
             };
+            *row_scale = scale;
             let active = !inequality || value > 0.0 || lam < 0.0;
             // Rows whose compliance lives in their value (edges: the target follows λ) take
             // no α̃λ term in their residual.
@@ -689,7 +742,7 @@ impl ShapeSolver {
                 -(value + *extra * lam)
             };
             *viol = if residual_is_compliant {
-                (value + *extra * lam).abs()
+                (value + *extra * lam).abs() / scale
             } else if inequality {
                 value.max(0.0) / scale
             } else {
@@ -699,7 +752,7 @@ impl ShapeSolver {
         if self.c.len() >= PAR_MIN {
             grad.par_chunks_mut(SLOTS)
                 .zip(self.c.par_iter_mut())
-                .zip(extras.par_iter_mut())
+                .zip(extras.par_iter_mut().zip(scales.par_iter_mut()))
                 .zip(self.b.par_iter_mut())
                 .zip(self.viol.par_iter_mut())
                 .enumerate()
@@ -707,7 +760,7 @@ impl ShapeSolver {
         } else {
             grad.chunks_mut(SLOTS)
                 .zip(self.c.iter_mut())
-                .zip(extras.iter_mut())
+                .zip(extras.iter_mut().zip(scales.iter_mut()))
                 .zip(self.b.iter_mut())
                 .zip(self.viol.iter_mut())
                 .enumerate()
@@ -787,7 +840,7 @@ impl ShapeSolver {
         for (r, (l, d)) in self.lambda.iter_mut().zip(&self.dl).enumerate() {
             *l += d * scale;
             let inequality = match st.kinds[r] {
-                RowKind::Edge(_) => p.axial == ConstraintKind::StretchOnly,
+                RowKind::Edge(_) => p.axial == ConstraintKind::StretchOnly || st.gathered[r],
                 RowKind::Tie(_) => true,
                 RowKind::Cell(_) | RowKind::Bend(..) => false,
             };
@@ -835,6 +888,49 @@ impl ShapeSolver {
         }
     }
 
+    /// The contact planes in the Newton system: a node that lies on its plane (pushed there by
+    /// the last projection) moves only along it in the next step, W = w(I − nnᵀ) — unless the
+    /// rows' forces pull it off the plane, when it is released. Without this the Newton step
+    /// moves nodes through the body, the projection pushes them back, and a seam drawn
+    /// together around the body never converges. Renews the factorization when the set
+    /// changed.
+    fn update_contacts(&mut self, p: &ShapeProblem<'_>, vel: &[V3]) {
+        let Some(st) = self.structure.as_mut() else {
+            return;
+        };
+        let n = self.root.len();
+        if self.on_plane.len() != n {
+            self.on_plane = vec![false; n];
+        }
+        let mut changed = false;
+        for i in 0..n {
+            let r = self.root[i] as usize;
+            let plane = &p.planes[i];
+            let mut on = false;
+            if plane.normal != V3::zeros() && st.system.weight[r].w > 0.0 {
+                let x = p.positions[i] + vel[i] * p.dt;
+                let d = (x - plane.point).dot(&plane.normal);
+                let pulled_off = st.system.jt_at(&self.lambda, r).dot(&plane.normal) > 0.0;
+                on = d <= 1e-6 * self.spacing[i] && !pulled_off;
+            }
+            if on != self.on_plane[i] {
+                self.on_plane[i] = on;
+                changed = true;
+            }
+        }
+        if changed {
+            for w in st.system.weight.iter_mut() {
+                w.n = V3::zeros();
+            }
+            for i in 0..n {
+                if self.on_plane[i] {
+                    st.system.weight[self.root[i] as usize].n = p.planes[i].normal;
+                }
+            }
+            st.system.invalidate();
+        }
+    }
+
     /// Pins at their prescribed positions, groups collapsed, nodes pushed in front of their
     /// planes (with friction), groups collapsed again.
     fn project(&self, p: &ShapeProblem<'_>, vel: &mut [V3]) {
@@ -843,15 +939,30 @@ impl ShapeSolver {
             vel[i] = (pin.position(p.time + p.dt) - p.positions[i]) / p.dt;
         }
         self.collapse(p, vel);
-        let mut any = false;
+        let inv = p.cloth.inverse_masses();
         for (i, plane) in p.planes.iter().enumerate() {
-            if plane.normal != V3::zeros() {
-                vel[i] = plane_push(vel[i], &p.positions[i], plane, p.dt);
-                any = true;
+            if plane.normal == V3::zeros() {
+                continue;
             }
-        }
-        if any {
-            self.collapse(p, vel);
+            let pushed = plane_push(vel[i], &p.positions[i], plane, p.dt);
+            let change = pushed - vel[i];
+            if change == V3::zeros() {
+                continue;
+            }
+            // A sewn group moves as one point: the push of one member's plane moves all of
+            // them (pushing the member alone and collapsing again would move the group by
+            // only its share, and repeated projections would drift it outwards).
+            let r = self.root[i] as usize;
+            let members = &self.members[self.member_ptr[r] as usize..self.member_ptr[r + 1] as usize];
+            if members.len() > 1 {
+                for &k in members {
+                    if inv[k as usize] > 0.0 {
+                        vel[k as usize] += change;
+                    }
+                }
+            } else {
+                vel[i] = pushed;
+            }
         }
     }
 
@@ -890,6 +1001,33 @@ impl ShapeSolver {
         loop {
             if std::env::var_os("ATELIER_DEBUG").is_some() {
                 eprintln!("  it {} viol {violation:.3e} {worst:?} merit {:.3e} backtracks {}", report.iterations, self.merit, report.backtracks);
+                let st = self.structure.as_ref().unwrap();
+                let mut parts = [0.0f64; 4];
+                for (r, k) in st.kinds.iter().enumerate() {
+                    let i = match k { RowKind::Edge(_) => 0, RowKind::Cell(_) => 1, RowKind::Bend(..) => 2, RowKind::Tie(_) => 3 };
+                    parts[i] += self.viol[r] * self.viol[r];
+                }
+                eprintln!("     merit parts edge {:.3e} cell {:.3e} bend {:.3e} tie {:.3e} planes {:.3e}", parts[0], parts[1], parts[2], parts[3], self.merit - parts.iter().sum::<f64>());
+                if let Some(Constraint::Tie(t)) = worst {
+                    let st = self.structure.as_ref().unwrap();
+                    let tie = p.ties[t];
+                    let r = st.kinds.iter().position(|k| matches!(k, RowKind::Tie(j) if self.open_tie_index[*j as usize] as usize == t)).unwrap();
+                    let (ra, rb) = (self.root[tie.a as usize] as usize, self.root[tie.b as usize] as usize);
+                    let cnt = |r: usize| self.member_ptr[r + 1] - self.member_ptr[r];
+                    for inc in p.cloth.incidence(tie.a as usize) {
+                        let e = p.cloth.topology().edges()[inc.edge as usize];
+                        eprintln!("       edge at a: {} -> {} {:?} rest {:.4}", tie.a, inc.other, e.kind, e.rest_length);
+                    }
+                    for inc in p.cloth.incidence(tie.b as usize) {
+                        let e = p.cloth.topology().edges()[inc.edge as usize];
+                        eprintln!("       edge at b: {} -> {} {:?} rest {:.4}", tie.b, inc.other, e.kind, e.rest_length);
+                    }
+                    let others: Vec<_> = p.ties.iter().enumerate().filter(|(_, x)| x.a == tie.a || x.b == tie.a || x.a == tie.b || x.b == tie.b).map(|(k, x)| (k, x.a, x.b, x.length)).collect();
+                    eprintln!("       ties at a, b: {others:?}");
+                    eprintln!("     tie {t} a {} b {} len {:.4} C {:.4e} lambda {:.3e} b {:.3e} roots {ra} {rb} members {} {} w {:.3e} {:.3e} planes {} {} dead {} xa {:?} xb {:?}",
+                        tie.a, tie.b, tie.length, self.c[r], self.lambda[r], self.b[r], cnt(ra), cnt(rb), st.system.weight[ra].w, st.system.weight[rb].w,
+                        p.planes[tie.a as usize].normal != V3::zeros(), p.planes[tie.b as usize].normal != V3::zeros(), st.dead[r], self.pred[tie.a as usize], self.pred[tie.b as usize]);
+                }
             }
             report.violation = violation;
             report.worst = worst;
@@ -906,6 +1044,7 @@ impl ShapeSolver {
                 method,
                 ShapeMethod::Direct { .. } | ShapeMethod::ConjugateGradient { .. }
             ) {
+                self.update_contacts(p, vel);
                 self.shift_towards_balance(p, vel);
             }
             let newton = match method {
@@ -946,6 +1085,9 @@ impl ShapeSolver {
                             Par::Seq,
                         )?;
                         report.linear_iterations += stats.iterations;
+                    }
+                    if std::env::var_os("ATELIER_DEBUG").is_some() {
+                        eprintln!("     linear {stats:?} fresh {fresh}");
                     }
                     true
                 }
@@ -1015,7 +1157,9 @@ impl ShapeSolver {
                 // What the hard constraints and the pressure change moves the base point too.
                 self.hat.copy_from_slice(vel);
                 after(vel);
-                self.project(p, vel);
+                if std::env::var_os("ATELIER_NOPROJ").is_none() {
+                    self.project(p, vel);
+                }
                 for ((b, v), before) in self.base.iter_mut().zip(vel.iter()).zip(&self.hat) {
                     *b += v - before;
                 }
