@@ -11,6 +11,7 @@
 //! - [`Solver::step`]: one step, with [`StepParams`] and a [`StepReport`] of diagnostics.
 
 pub mod baselines;
+pub mod bend_angle;
 pub mod cloth;
 pub mod contact;
 pub mod dual;

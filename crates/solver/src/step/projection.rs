@@ -30,6 +30,7 @@ use super::{Tie, plane_push};
 use crate::cloth::Cloth;
 use crate::dual::{DualError, DualSystem, NONE, NodeWeight, Preconditioner, SLOTS};
 use crate::params::{ConstraintKind, ShapeMethod};
+use crate::bend_angle::turn_and_gradient;
 use crate::shear_angle::{ShearMeasure, cell_angle_gradient};
 
 type V3 = Vector3<f64>;
@@ -74,13 +75,13 @@ pub struct CellShear {
 }
 
 /// One node's bending along one grid direction for this step (the implicit bending model): the
-/// turn of the grid line through the node, C = n·(t₊ − t₋) with n the node normal at the start
-/// of the step and t± the unit vectors of the edges beyond and before the node, held by a
-/// compliant constraint linearised about the start of the step.
+/// turn θ of the grid line through the node about an axis fixed over the step
+/// ([`crate::bend_angle`]), held by a compliant constraint linearised about the start of the
+/// step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct NodeBend {
-    /// Node normal at the start of the step (frozen over the step).
-    pub normal: V3,
+    /// The axis the turn is measured about (m = t̄ × n at the start of the step).
+    pub axis: V3,
     /// The turn at which the linearised moment vanishes, C₀ − m₀·l̄/k.
     pub offset: f64,
     /// Compliance l̄²/(k·S) (k the spindle's local slope, N·m; S the node's area; l̄ the mean
@@ -661,28 +662,22 @@ impl ShapeSolver {
                 }
                 RowKind::Bend(i, dir, [before, after]) => {
                     let bend = &p.bends[2 * i as usize + dir as usize];
-                    let n = bend.normal;
-                    let xi = pred[i as usize];
-                    let (ea, eb) = (xi - pred[before as usize], pred[after as usize] - xi);
-                    let (la, lb) = (ea.norm(), eb.norm());
-                    if la > 0.0 && lb > 0.0 {
-                        let (ta, tb) = (ea / la, eb / lb);
-                        let ga = (n - ta * n.dot(&ta)) / la;
-                        let gb = (n - tb * n.dot(&tb)) / lb;
-                        // C = n·t₊ − n·t₋: ∂/∂x₊ = g_b, ∂/∂x₋ = g_a, ∂/∂x_i = −g_a − g_b.
-                        g[slot[0] as usize] += ga;
-                        g[slot[1] as usize] -= ga + gb;
-                        g[slot[2] as usize] += gb;
-                        (
-                            n.dot(&tb) - n.dot(&ta) - bend.offset,
-                            bend.compliance / dt2,
-                            false,
-                            1.0,
-                            true,
-                        )
-                    } else {
-                        (0.0, 1.0, false, 1.0, true)
+                    let (theta, grad) = turn_and_gradient(
+                        &bend.axis,
+                        &pred[before as usize],
+                        &pred[i as usize],
+                        &pred[after as usize],
+                    );
+                    for k in 0..3 {
+                        g[slot[k] as usize] += grad[k];
                     }
+                    (
+                        theta - bend.offset,
+                        bend.compliance / dt2,
+                        false,
+                        1.0,
+                        true,
+                    )
                 }
                 RowKind::Tie(t) => {
                     let tie = &ties[tie_index[t as usize] as usize];

@@ -10,6 +10,7 @@ use super::Solver;
 use super::bending::regularised;
 use super::par::fill;
 use super::projection::{CellShear, NodeBend};
+use crate::bend_angle::{turn_and_gradient, turn_axis};
 use crate::cloth::Cloth;
 use crate::params::{BendingModel, StepParams};
 use crate::shear_angle::cell_angle;
@@ -105,8 +106,9 @@ impl Solver {
 
 impl Solver {
     /// Each node's bending constraints for this step ([`BendingModel::Implicit`]): per grid
-    /// direction with both neighbours, the turn C₀ = n·(t₊ − t₋) at the start of the step (n the
-    /// node normal of stage 1), the curvature η₀ = C₀/l̄, the spindle's moment per width m₀ and
+    /// direction with both neighbours, the turn C₀ of the line at the start of the step about
+    /// its axis t̄ × n (n the node normal of stage 1; [`crate::bend_angle`]), the curvature
+    /// η₀ = C₀/l̄, the spindle's moment per width m₀ and
     /// local slope k there (through the hysteresis state of the direction's `+` slot; Bη and B
     /// without hysteresis); the constraint C − (C₀ − m₀ l̄/k) = 0 with compliance l̄²/(k·S).
     /// Nothing with the thesis's bending model or `bending_off`.
@@ -138,9 +140,9 @@ impl Solver {
             let l = 0.5
                 * (edges[axial_edges[i][2 * dir] as usize].rest_length
                     + edges[axial_edges[i][2 * dir + 1] as usize].rest_length);
-            let nrm = normal[i];
-            let (ea, eb) = (pos[i] - pos[before as usize], pos[after as usize] - pos[i]);
-            let c0 = nrm.dot(&(eb / eb.norm())) - nrm.dot(&(ea / ea.norm()));
+            let (xb, xa) = (&pos[before as usize], &pos[after as usize]);
+            let axis = turn_axis(xb, &pos[i], xa, &normal[i]);
+            let c0 = turn_and_gradient(&axis, xb, &pos[i], xa).0;
             let eta = c0 / l;
             let spindle = regularised(table.bending(mats[i][2 * dir]), stick, band);
             let b = spindle.rigidity();
@@ -156,7 +158,7 @@ impl Solver {
                 (b * eta, b)
             };
             NodeBend {
-                normal: nrm,
+                axis,
                 offset: c0 - m * l / slope,
                 compliance: l * l / (slope * areas[i]),
             }

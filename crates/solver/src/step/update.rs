@@ -9,6 +9,7 @@ use super::bending::regularised;
 use super::par::fill;
 use crate::cloth::Cloth;
 use crate::params::{BendingModel, ConstraintKind, StepParams, Tension};
+use crate::bend_angle::turn_and_gradient;
 use crate::shear_angle::cell_angle;
 use crate::state::ClothState;
 
@@ -136,9 +137,14 @@ impl Solver {
                     let l = 0.5
                         * (edges[axial_edges[i][2 * dir] as usize].rest_length
                             + edges[axial_edges[i][2 * dir + 1] as usize].rest_length);
-                    let nrm = self.s.node_bend[2 * i + dir].normal;
-                    let (ea, eb) = (pos[i] - pos[before as usize], pos[after as usize] - pos[i]);
-                    let eta = (nrm.dot(&(eb / eb.norm())) - nrm.dot(&(ea / ea.norm()))) / l;
+                    let axis = self.s.node_bend[2 * i + dir].axis;
+                    let eta = turn_and_gradient(
+                        &axis,
+                        &pos[before as usize],
+                        &pos[i],
+                        &pos[after as usize],
+                    )
+                    .0 / l;
                     let spindle = regularised(
                         table.bending(smats[i][2 * dir]),
                         params.bending_stick_slope,
