@@ -303,7 +303,7 @@ impl Cloth {
                 phase_slot[e as usize] = k as u32;
             }
         }
-        let shear = fabric.shear_loop().map_err(|source| ClothError::Material {
+        let shear = fabric.material_shear_loop().map_err(|source| ClothError::Material {
             fabric: fabric.name.clone(),
             source,
         })?;

@@ -536,24 +536,6 @@ pub fn shear_values(upper: &[(f64, f64)], lower: &[(f64, f64)]) -> ShearValues {
     }
 }
 
-/// The fabric with the KES-FB1 pretension's own contribution taken out of its shear stiffness:
-/// G − T per radian (T the pretension per width, N/m). KES-FB1 reports the force on the moving
-/// clamp as it is; under the pretension T the warp yarns between the clamps, tilted by γ, pull
-/// the clamp back with T·tan γ per width on top of the fabric's own shear resistance, so a
-/// KES G contains T (10 gf/cm: 0.1745 gf/(cm·deg)). A cloth model whose cells resist with the
-/// KES G, and whose yarns carry their tension besides, counts that term twice; the material's
-/// share is G − T. The loop's widths are untouched (the term is elastic). None when the fabric
-/// has no shear section or G ≤ T.
-pub fn without_pretension_term(fabric: &Fabric, tension: f64) -> Option<Fabric> {
-    let mut f = fabric.clone();
-    let s = f.shear.as_mut()?;
-    if s.stiffness <= tension {
-        return None;
-    }
-    s.stiffness -= tension;
-    Some(f)
-}
-
 /// The virtual KES-FB1 shear test (warp across the clamps, as the standard has it): the
 /// specimen pulled to `protocol.tension` across the clamps, then the moving clamp slid parallel
 /// to itself (along x) through 0 → +max → −max → +max at `protocol.rate`.
