@@ -654,7 +654,7 @@ impl ShapeSolver {
                     for k in 0..4 {
                         g[slot[k] as usize] -= grad[k];
                     }
-                    if gamma.abs() > sh.lock && std::env::var_os("ATELIER_NOLOCK").is_none() {
+                    if gamma.abs() > sh.lock {
                         (gamma - sh.lock.copysign(gamma), 0.0, false, 1.0, false)
                     } else {
                         (gamma - sh.offset, sh.compliance / dt2, false, 1.0, true)
@@ -994,36 +994,6 @@ impl ShapeSolver {
         let mut omega = 1.0;
         let (mut violation, mut worst) = self.evaluate(p, vel);
         loop {
-            if std::env::var_os("ATELIER_DEBUG").is_some() {
-                eprintln!("  it {} viol {violation:.3e} {worst:?} merit {:.3e} backtracks {}", report.iterations, self.merit, report.backtracks);
-                let st = self.structure.as_ref().unwrap();
-                let mut parts = [0.0f64; 4];
-                for (r, k) in st.kinds.iter().enumerate() {
-                    let i = match k { RowKind::Edge(_) => 0, RowKind::Cell(_) => 1, RowKind::Bend(..) => 2, RowKind::Tie(_) => 3 };
-                    parts[i] += self.viol[r] * self.viol[r];
-                }
-                eprintln!("     merit parts edge {:.3e} cell {:.3e} bend {:.3e} tie {:.3e} planes {:.3e}", parts[0], parts[1], parts[2], parts[3], self.merit - parts.iter().sum::<f64>());
-                if let Some(Constraint::Tie(t)) = worst {
-                    let st = self.structure.as_ref().unwrap();
-                    let tie = p.ties[t];
-                    let r = st.kinds.iter().position(|k| matches!(k, RowKind::Tie(j) if self.open_tie_index[*j as usize] as usize == t)).unwrap();
-                    let (ra, rb) = (self.root[tie.a as usize] as usize, self.root[tie.b as usize] as usize);
-                    let cnt = |r: usize| self.member_ptr[r + 1] - self.member_ptr[r];
-                    for inc in p.cloth.incidence(tie.a as usize) {
-                        let e = p.cloth.topology().edges()[inc.edge as usize];
-                        eprintln!("       edge at a: {} -> {} {:?} rest {:.4}", tie.a, inc.other, e.kind, e.rest_length);
-                    }
-                    for inc in p.cloth.incidence(tie.b as usize) {
-                        let e = p.cloth.topology().edges()[inc.edge as usize];
-                        eprintln!("       edge at b: {} -> {} {:?} rest {:.4}", tie.b, inc.other, e.kind, e.rest_length);
-                    }
-                    let others: Vec<_> = p.ties.iter().enumerate().filter(|(_, x)| x.a == tie.a || x.b == tie.a || x.a == tie.b || x.b == tie.b).map(|(k, x)| (k, x.a, x.b, x.length)).collect();
-                    eprintln!("       ties at a, b: {others:?}");
-                    eprintln!("     tie {t} a {} b {} len {:.4} C {:.4e} lambda {:.3e} b {:.3e} roots {ra} {rb} members {} {} w {:.3e} {:.3e} planes {} {} dead {} xa {:?} xb {:?}",
-                        tie.a, tie.b, tie.length, self.c[r], self.lambda[r], self.b[r], cnt(ra), cnt(rb), st.system.weight[ra].w, st.system.weight[rb].w,
-                        p.planes[tie.a as usize].normal != V3::zeros(), p.planes[tie.b as usize].normal != V3::zeros(), st.dead[r], self.pred[tie.a as usize], self.pred[tie.b as usize]);
-                }
-            }
             report.violation = violation;
             report.worst = worst;
             if violation <= tol {
@@ -1080,9 +1050,6 @@ impl ShapeSolver {
                             Par::Seq,
                         )?;
                         report.linear_iterations += stats.iterations;
-                    }
-                    if std::env::var_os("ATELIER_DEBUG").is_some() {
-                        eprintln!("     linear {stats:?} fresh {fresh}");
                     }
                     true
                 }
@@ -1152,9 +1119,7 @@ impl ShapeSolver {
                 // What the hard constraints and the pressure change moves the base point too.
                 self.hat.copy_from_slice(vel);
                 after(vel);
-                if std::env::var_os("ATELIER_NOPROJ").is_none() {
-                    self.project(p, vel);
-                }
+                self.project(p, vel);
                 for ((b, v), before) in self.base.iter_mut().zip(vel.iter()).zip(&self.hat) {
                     *b += v - before;
                 }
