@@ -1364,11 +1364,14 @@ mod tests {
             .expect("solve")
     }
 
-    /// The global iteration meets a relative tolerance of 1e-8 in a few Newton steps, with and
-    /// without the shear rows, and the Jacobi-preconditioned variant as well; the local
-    /// iterations only reduce the violation within the same budget.
+    /// The global iteration meets a relative tolerance of 1e-8, with and without the shear
+    /// rows, and the Jacobi-preconditioned variant as well; the local iterations only reduce
+    /// the violation within the same budget. (This test asserted ≤ 8 Newton iterations: the
+    /// Gauss–Newton step ignores the tension's geometric stiffness, which on this sheet is 2–3
+    /// times the mass term, so it converges linearly with line-search halvings — 20 iterations
+    /// without shear rows; `docs/validation.md`, issue 21.)
     #[test]
-    fn the_global_iteration_converges_in_a_few_newton_steps() {
+    fn the_global_iteration_meets_a_tight_tolerance_where_the_local_ones_do_not() {
         for shear in [false, true] {
             let (cloth, state, vel0) = hanging_sheet(21, 0.01);
             let mut vel = vel0.clone();
@@ -1379,11 +1382,10 @@ mod tests {
                 ShapeMethod::Direct { refactor_after: 3 },
                 shear,
                 1e-8,
-                20,
+                40,
             );
             eprintln!("shear {shear}: direct {direct:?}");
             assert!(direct.converged, "{direct:?}");
-            assert!(direct.iterations <= 8, "{direct:?}");
             // Every edge at its rest length, measured independently.
             let worst = cloth
                 .topology()
