@@ -109,12 +109,12 @@ fn parse_source(text: &str) -> Source {
         if depth == 0 {
             if let Some(rest) = line.strip_prefix("use crate::") {
                 let path = rest.trim_end_matches(';');
-                if let Some((module, name)) = path.rsplit_once("::") {
-                    if !name.contains('{') {
-                        source
-                            .imports
-                            .push((module.replace("::", "/"), name.to_string()));
-                    }
+                if let Some((module, name)) = path.rsplit_once("::")
+                    && !name.contains('{')
+                {
+                    source
+                        .imports
+                        .push((module.replace("::", "/"), name.to_string()));
                 }
             }
             let kind = if let Some(rest) = line.strip_prefix("pub struct ") {
@@ -135,14 +135,14 @@ fn parse_source(text: &str) -> Source {
         } else if let Some((_, _, item)) = current.as_mut() {
             match item {
                 Item::Struct(fields) if depth == 1 => {
-                    if let Some(rest) = line.strip_prefix("pub ") {
-                        if let Some((name, ty)) = rest.split_once(':') {
-                            fields.push(Field {
-                                name: name.trim().to_string(),
-                                ty: ty.trim().trim_end_matches(',').trim().to_string(),
-                                doc: joined,
-                            });
-                        }
+                    if let Some(rest) = line.strip_prefix("pub ")
+                        && let Some((name, ty)) = rest.split_once(':')
+                    {
+                        fields.push(Field {
+                            name: name.trim().to_string(),
+                            ty: ty.trim().trim_end_matches(',').trim().to_string(),
+                            doc: joined,
+                        });
                     }
                 }
                 Item::Enum(variants) if depth == 1 => {
@@ -173,10 +173,10 @@ fn parse_source(text: &str) -> Source {
             }
         }
         depth += brace_delta(line);
-        if depth == 0 {
-            if let Some(done) = current.take() {
-                source.items.push(done);
-            }
+        if depth == 0
+            && let Some(done) = current.take()
+        {
+            source.items.push(done);
         }
     }
     source
@@ -238,10 +238,10 @@ fn unit(doc: &str) -> String {
     let clause = doc[..end].trim_end_matches('.');
     let looks_like_unit =
         |u: &str| !u.is_empty() && !u.contains(' ') && !u.contains('`') && u.chars().count() <= 12;
-    if let Some((_, candidate)) = clause.rsplit_once(", ") {
-        if looks_like_unit(candidate) {
-            return candidate.to_string();
-        }
+    if let Some((_, candidate)) = clause.rsplit_once(", ")
+        && looks_like_unit(candidate)
+    {
+        return candidate.to_string();
     }
     let lead: String = doc
         .chars()
@@ -431,17 +431,17 @@ pub fn generate(root: &Path) -> Result<String> {
         let mut variant_fields = Vec::new();
         for (field, variants, value) in &enums {
             let default = variant_of(value);
-            if let Some(stated) = variants.iter().find(|v| v.doc.contains("The default.")) {
-                if Some(stated.name.as_str()) != default {
-                    bail!(
-                        "the doc comment of `{}::{}` says it is the default, \
-                         StepParams::default() has `{}: {}`",
-                        field.ty,
-                        stated.name,
-                        field.name,
-                        render(value)
-                    );
-                }
+            if let Some(stated) = variants.iter().find(|v| v.doc.contains("The default."))
+                && Some(stated.name.as_str()) != default
+            {
+                bail!(
+                    "the doc comment of `{}::{}` says it is the default, \
+                     StepParams::default() has `{}: {}`",
+                    field.ty,
+                    stated.name,
+                    field.name,
+                    render(value)
+                );
             }
             for (i, variant) in variants.iter().enumerate() {
                 let names: Vec<&str> = variant.fields.iter().map(|f| f.name.as_str()).collect();
