@@ -23,6 +23,9 @@
 //! - `cargo xtask bench-report [--out DIR] [--skip STEP…]` — every criterion bench, the
 //!   time-against-error studies, the stability map, the peers and the benchmark scenarios, then
 //!   `docs/performance.md` regenerated from `xtask/performance.md.in` (about an hour on 2 cores).
+//! - `cargo xtask knob-table [--check]` — the table of `StepParams`' knobs in `docs/solver.md`
+//!   regenerated from `StepParams::default()` and the doc comments of `params.rs`; `--check`
+//!   fails if the file is out of date (so does `cargo test --workspace`).
 //! - `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]` — every scenario of
 //!   `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on a full run
 //!   `docs/results.md` with its gallery; fails if a scenario fails or misses an expectation.
@@ -38,6 +41,7 @@ mod figures_stability;
 mod figures_tradeoff;
 mod figures_tryon;
 mod figures_wet;
+mod knob_table;
 mod plot;
 mod run_scenarios;
 
@@ -87,6 +91,13 @@ enum Command {
         /// Reuse an earlier run's output of these steps instead of running them.
         #[arg(long, num_args = 1..)]
         skip: Vec<bench_report::Step>,
+    },
+    /// Regenerate the table of the step's knobs in docs/solver.md from `StepParams::default()`
+    /// and the doc comments of crates/solver/src/params.rs.
+    KnobTable {
+        /// Write nothing; fail if docs/solver.md differs from what would be written.
+        #[arg(long)]
+        check: bool,
     },
 }
 
@@ -163,6 +174,14 @@ fn main() -> Result<()> {
             let root = repository_root();
             let out = out.unwrap_or_else(|| root.join("target/bench-report"));
             bench_report::run(&root, &out, &skip)?;
+        }
+        Command::KnobTable { check } => {
+            if !knob_table::run(&repository_root(), check)? {
+                eprintln!(
+                    "docs/solver.md's knob table is out of date: run `cargo xtask knob-table`"
+                );
+                std::process::exit(1);
+            }
         }
     }
     Ok(())
