@@ -724,7 +724,7 @@ fn virtual_kes_runs_report_their_convergence() {
         fabric.display()
     );
     let report = run_text(&tensile, &out);
-    assert_eq!(report.dt_s, 0.01);
+    assert_eq!(report.dt_s.to_bits(), 0.01_f64.to_bits());
     let steps = (report.simulated_s / 0.01).round() as usize;
     assert!(steps > 10, "{steps}");
     assert_counted(&report, steps, 1e-7);
