@@ -9,8 +9,8 @@
 //! The baselines (XPBD, mass-spring, Yamada's model) have no tolerance to meet: their
 //! convergence fields are `null`, not 0.
 
-use atelier_solver::StepReport;
 use atelier_solver::step::Constraint;
+use atelier_solver::{SolveStats, StepReport};
 use serde::{Deserialize, Serialize};
 
 use crate::simulation::Phase;
@@ -147,6 +147,22 @@ impl Convergence {
             max_violation: Some(max_violation),
             tolerance: Some(tolerance),
             worst: None,
+        }
+    }
+
+    /// From the counts a solver's own runner kept ([`SolveStats`]: the virtual KES instruments,
+    /// the PARTY runs of wet scenes); no schedule phase.
+    pub fn from_stats(solver: &str, stats: &SolveStats) -> Self {
+        Self {
+            solver: solver.into(),
+            steps: stats.steps,
+            unconverged_steps: Some(stats.unconverged),
+            shape_unconverged_steps: Some(stats.shape_unconverged),
+            max_violation: Some(stats.worst_violation),
+            tolerance: Some(stats.tolerance),
+            worst: stats
+                .worst
+                .map(|c| WorstStep::new(c, stats.worst_violation, stats.worst_time, None)),
         }
     }
 
@@ -296,5 +312,30 @@ mod tests {
         assert!(b.warning().is_none() && !b.any_unconverged());
         let json = serde_json::to_string(&b).expect("json");
         assert!(json.contains("\"unconverged_steps\":null"), "{json}");
+    }
+
+    #[test]
+    fn solver_stats_become_a_convergence() {
+        let stats = SolveStats {
+            steps: 40,
+            unconverged: 3,
+            shape_unconverged: 2,
+            worst_violation: 2e-6,
+            worst: Some(Constraint::Bend(5, 1)),
+            worst_time: 1.25,
+            tolerance: 1e-7,
+        };
+        let c = Convergence::from_stats(solvers::PARTY, &stats);
+        assert_eq!(c.steps, 40);
+        assert_eq!(c.unconverged_steps, Some(3));
+        assert_eq!(c.shape_unconverged_steps, Some(2));
+        assert_eq!((c.max_violation, c.tolerance), (Some(2e-6), Some(1e-7)));
+        let w = c.worst.as_ref().expect("worst");
+        assert_eq!(w.describe(), "bend (v) of node 5, step at t = 1.250 s");
+        assert!(
+            c.warning()
+                .expect("a warning")
+                .starts_with("3 of 40 party steps (7.5 %)")
+        );
     }
 }

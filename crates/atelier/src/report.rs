@@ -83,6 +83,15 @@ pub struct Comparison {
     pub convergence: Option<Convergence>,
 }
 
+impl Comparison {
+    /// The warning about the compared run's unconverged steps (`the compared party run: …`),
+    /// if some step did not converge.
+    pub fn convergence_warning(&self) -> Option<String> {
+        let w = self.convergence.as_ref().and_then(Convergence::warning)?;
+        Some(format!("the compared {} run: {w}", self.solver))
+    }
+}
+
 /// One expectation and its outcome.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -243,22 +252,35 @@ impl Report {
                 .is_none_or(|t| t.iou_after >= crate::tryon::LOW_IOU)
     }
 
-    /// Whether some step did not converge and the scenario does not bound
-    /// `unconverged_fraction` itself: the run's numbers are not all converged results, and
-    /// the run does not pass.
+    /// Whether some step did not converge — the run's, or a wet scene's compared run's (its
+    /// `compare_*` metrics) — and the scenario does not bound `unconverged_fraction` itself:
+    /// the run's numbers are not all converged results, and the run does not pass.
     pub fn unconverged(&self) -> bool {
-        self.convergence
+        let compared = self
+            .comparison
             .as_ref()
-            .is_some_and(Convergence::any_unconverged)
+            .and_then(|c| c.convergence.as_ref());
+        self.convergence
+            .iter()
+            .chain(compared)
+            .any(Convergence::any_unconverged)
             && !self
                 .expectations
                 .iter()
                 .any(|e| e.metric == UNCONVERGED_FRACTION)
     }
 
-    /// The warning about the run's unconverged steps, if some step did not converge.
+    /// The warning about the run's unconverged steps, if some step did not converge; else the
+    /// compared run's (wet scenes), if some of its steps did not.
     pub fn convergence_warning(&self) -> Option<String> {
-        self.convergence.as_ref().and_then(Convergence::warning)
+        self.convergence
+            .as_ref()
+            .and_then(Convergence::warning)
+            .or_else(|| {
+                self.comparison
+                    .as_ref()
+                    .and_then(Comparison::convergence_warning)
+            })
     }
 
     /// One line: name, outcome, steps and wall time, and the failure, the unmet expectations

@@ -1208,8 +1208,8 @@ fn kes_tensile(spec: &KesTensileSpec, fabric: &Fabric) -> Result<Simulated, RunE
     kes_simulated(
         curve.cloth,
         &curve.state,
-        curve.steps,
-        0.01,
+        &curve.stats,
+        kes::TensileProtocol::default().dt,
         wall,
         metrics,
         chart,
@@ -1280,18 +1280,20 @@ fn kes_bending(spec: &KesBendingSpec, fabric: &Fabric) -> Result<Simulated, RunE
     kes_simulated(
         curve.cloth,
         &curve.state,
-        curve.steps,
-        1e-3,
+        &curve.stats,
+        curve.dt,
         wall,
         metrics,
         chart,
     )
 }
 
+/// A virtual KES test's outputs: its specimen at the end, its steps (`stats`, counted by the
+/// instrument) of `dt`, and its loop as the chart.
 fn kes_simulated(
     cloth: Cloth,
     state: &ClothState,
-    steps: usize,
+    stats: &atelier_solver::SolveStats,
     dt: f64,
     wall: f64,
     mut metrics: BTreeMap<String, Option<f64>>,
@@ -1312,7 +1314,7 @@ fn kes_simulated(
         cloth_triangles: cloth.topology().triangles().to_vec(),
         cloth: kes_frames(rest, state, state.time),
         solid: None,
-        steps,
+        steps: stats.steps,
         dt,
         simulated: state.time,
         wall_seconds: wall,
@@ -1324,7 +1326,6 @@ fn kes_simulated(
         wet: None,
         fit: None,
         comparison: None,
-        // `atelier_solver::kes` does not hand out its steps' reports (yet): not reported.
-        convergence: Some(Convergence::not_reported(solvers::PARTY, steps)),
+        convergence: Some(Convergence::from_stats(solvers::PARTY, stats)),
     })
 }

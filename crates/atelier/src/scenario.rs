@@ -305,7 +305,8 @@ pub struct KesBendingSpec {
     /// Direction of the specimen. Default `Warp`.
     #[serde(default)]
     pub direction: StripDirection,
-    /// Steps of 1 ms per leg of the cycle 0 → +2.5 → −2.5 → 0 cm⁻¹. Default 500.
+    /// Steps per 2.5 cm⁻¹ leg of the cycle 0 → +2.5 → −2.5 → 0 cm⁻¹ (at the KES rate
+    /// 0.5 cm⁻¹/s, Δt = 5 s / `steps_per_leg`; at least 50). Default 500.
     #[serde(default = "default_kes_steps")]
     pub steps_per_leg: usize,
 }

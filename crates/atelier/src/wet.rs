@@ -106,11 +106,13 @@ pub struct WetOutputs {
     pub size: f64,
 }
 
-/// Whether a run's steps converged. Yamada's model has no tolerance (a baseline); the PARTY
-/// runs of `atelier_solver::wet::scene::run` do not hand out their steps' reports (yet): both
-/// are not reported (`null`).
+/// Whether a run's steps converged: the PARTY step's reports as the run counted them
+/// (`WetRun::stats`); Yamada's model has no tolerance (a baseline): not reported (`null`).
 fn convergence(r: &WetRun) -> Convergence {
-    Convergence::not_reported(r.solver, r.steps)
+    match &r.stats {
+        Some(stats) => Convergence::from_stats(r.solver, stats),
+        None => Convergence::not_reported(r.solver, r.steps),
+    }
 }
 
 /// The metrics of one run (without the `compare_` ones).
@@ -249,17 +251,7 @@ pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> 
             "rms_difference_mm".into(),
             (!failed && main.failure.is_none()).then(|| main.rms_distance(c) * 1e3),
         );
-        let c_convergence = convergence(c);
-        if let Some(w) = c_convergence.warning() {
-            warnings.push(format!("the compared {} run: {w}", c.solver));
-        }
-        if let Some(f) = &c.failure {
-            warnings.push(format!(
-                "the compared {} run stopped at t = {:.3} s: {}",
-                c.solver, f.time, f.error
-            ));
-        }
-        comparison = Some(Comparison {
+        let compared = Comparison {
             solver: c.solver.into(),
             dt_s: c.dt,
             steps: c.steps,
@@ -267,8 +259,16 @@ pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> 
             wall_s: c.wall.as_secs_f64(),
             pressure_s: c.pressure_wall.as_secs_f64(),
             failure: c.failure.as_ref().map(|f| f.error.to_string()),
-            convergence: Some(c_convergence),
-        });
+            convergence: Some(convergence(c)),
+        };
+        warnings.extend(compared.convergence_warning());
+        if let Some(f) = &c.failure {
+            warnings.push(format!(
+                "the compared {} run stopped at t = {:.3} s: {}",
+                c.solver, f.time, f.error
+            ));
+        }
+        comparison = Some(compared);
     }
     let charts = charts(&main, compared.as_ref());
     let mut cloth = Animation::default();

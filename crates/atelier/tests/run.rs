@@ -662,3 +662,120 @@ fn unconverged_fraction_is_a_metric_of_every_kind_that_steps_a_cloth() {
     let e = Scenario::parse(fit, Path::new("f.ron")).expect_err("no solver steps");
     assert_eq!(e.field, "expectations[0].metric", "{e}");
 }
+
+/// What every counted run's `convergence` holds, checked against the report: the PARTY step,
+/// `steps` simulated steps, counts within them, a finite largest violation, the warning and
+/// the exit status following the count.
+fn assert_counted(report: &Report, steps: usize, tolerance: f64) {
+    let c = report.convergence.as_ref().expect("convergence reported");
+    assert_eq!(c.solver, "party");
+    assert_eq!(c.steps, steps, "{c:?}");
+    assert_eq!(report.steps, steps);
+    let unconverged = c.unconverged_steps.expect("counted, not null");
+    let shape = c.shape_unconverged_steps.expect("counted, not null");
+    assert!(shape <= unconverged && unconverged <= steps, "{c:?}");
+    assert!(c.max_violation.is_some_and(f64::is_finite), "{c:?}");
+    assert_eq!(c.tolerance, Some(tolerance));
+    if let Some(w) = &c.worst {
+        assert!(CONSTRAINTS.contains(&w.constraint.as_str()), "{w:?}");
+        assert!(w.phase.is_none() && w.time_s < report.simulated_s, "{w:?}");
+    }
+    assert_eq!(
+        report.metrics["unconverged_fraction"],
+        Some(unconverged as f64 / steps as f64)
+    );
+    assert_eq!(report.convergence_warning().is_some(), unconverged > 0);
+    if unconverged > 0 {
+        assert!(!report.passed());
+        assert!(
+            report.summary_line().contains("did not converge"),
+            "{}",
+            report.summary_line()
+        );
+    }
+}
+
+/// The virtual KES tests count their steps: a short FB2 bending test (100 steps per leg of
+/// 2.5 cm⁻¹ at the KES rate 0.5 cm⁻¹/s: four legs' worth, 20 s, at Δt 5 s / 100 = 0.05 s, is
+/// 400 steps) and an FB1 tensile test to 20 gf/cm (at the instrument's Δt 0.01 s, as many steps
+/// as its simulated time holds) both report a counted `convergence`, held to the
+/// instruments' shape tolerance 1e-7.
+#[test]
+fn virtual_kes_runs_report_their_convergence() {
+    let fabric = root().join("fixtures/fabrics/cotton_broad.ron");
+    let bending = format!(
+        r#"(name: "short_kes_bending", reproduces: "a short KES-FB2 bending test (test)",
+    kind: KesBending(fabric: "{}", direction: Warp, steps_per_leg: 100))"#,
+        fabric.display()
+    );
+    let out = temp_dir("kes-convergence");
+    let report = run_text(&bending, &out);
+    let (duration, dt) = (4.0 * 2.5 / 0.5, 5.0 / 100.0);
+    assert!(
+        (report.simulated_s - duration).abs() < 1e-6,
+        "{}",
+        report.simulated_s
+    );
+    assert!((report.dt_s - dt).abs() < 1e-12, "{}", report.dt_s);
+    assert_counted(&report, (duration / dt).round() as usize, 1e-7);
+    let tensile = format!(
+        r#"(name: "short_kes_tensile", reproduces: "a KES-FB1 tensile test to 20 gf/cm (test)",
+    kind: KesTensile(fabric: "{}", direction: Warp, max_force_gf_cm: 20.0))"#,
+        fabric.display()
+    );
+    let report = run_text(&tensile, &out);
+    assert_eq!(report.dt_s.to_bits(), 0.01_f64.to_bits());
+    let steps = (report.simulated_s / 0.01).round() as usize;
+    assert!(steps > 10, "{steps}");
+    assert_counted(&report, steps, 1e-7);
+    let written = std::fs::read_to_string(out.join(outputs::REPORT)).expect("report");
+    assert_eq!(Report::from_json(&written).expect("parses"), report);
+    std::fs::remove_dir_all(&out).ok();
+}
+
+/// A wet scene on the PARTY step counts its steps (0.1 s at Δt 5 ms: 20), and so does a
+/// compared PARTY run (at Δt 10 ms: 10), in `comparison.convergence`; its unconverged steps
+/// warn and make the run not pass as the main run's do.
+#[test]
+fn wet_party_runs_report_their_convergence() {
+    let text = format!(
+        r#"(
+    name: "short_wet",
+    reproduces: "a short wet pinch on the PARTY step, compared with itself at twice the step (test)",
+    kind: Wet(
+        fabric: "{}/fixtures/fabrics/polyester_satin_wet.ron",
+        scene: (
+            particles: 10,
+            pressure: (air: 3e-4),
+            picks: [(at: (0.5, 0.5), by: (0.0, 0.0, 0.01), speed: 0.05)],
+            duration: 0.1,
+        ),
+        solver: Party(dt: 0.005),
+        compare: Party(dt: 0.01),
+    ),
+)"#,
+        root().display()
+    );
+    let out = temp_dir("wet-convergence");
+    let report = run_text(&text, &out);
+    assert!(report.failure.is_none(), "{:?}", report.failure);
+    let (duration, dt, compared_dt): (f64, f64, f64) = (0.1, 0.005, 0.01);
+    assert_counted(&report, (duration / dt).round() as usize, 1e-4);
+    let compared = report.comparison.as_ref().expect("comparison");
+    let c = compared.convergence.as_ref().expect("its convergence");
+    assert_eq!(c.solver, "party");
+    assert_eq!(c.steps, (duration / compared_dt).round() as usize);
+    assert_eq!(compared.steps, c.steps);
+    let unconverged = c.unconverged_steps.expect("counted, not null");
+    assert!(c.shape_unconverged_steps.expect("counted") <= unconverged);
+    assert!(c.max_violation.is_some_and(f64::is_finite), "{c:?}");
+    let warned = report
+        .warnings
+        .iter()
+        .any(|w| w.starts_with("the compared party run: ") && w.contains("did not converge"));
+    assert_eq!(warned, unconverged > 0, "{:?}", report.warnings);
+    if unconverged > 0 {
+        assert!(report.unconverged() && !report.passed());
+    }
+    std::fs::remove_dir_all(&out).ok();
+}

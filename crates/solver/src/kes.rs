@@ -29,7 +29,7 @@ use nalgebra::Vector3;
 use crate::cloth::{Cloth, ClothError, PinMotion};
 use crate::params::StepParams;
 use crate::state::ClothState;
-use crate::step::{Constraint, Solver, StepError};
+use crate::step::{Solver, StepError};
 
 type V3 = Vector3<f64>;
 
@@ -63,39 +63,22 @@ pub enum KesError {
 }
 
 /// How well the steps of a virtual test met their constraints (the clamps read the constraint
-/// forces, so a step that stops short of its tolerance reads a wrong force).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SolveStats {
-    /// Steps taken.
-    pub steps: usize,
-    /// Steps whose shape stage stopped above its tolerance.
-    pub unconverged: usize,
-    /// The largest violation a step ended with (relative strain, rad).
-    pub worst_violation: f64,
-    /// The constraint that had it.
-    pub worst: Option<Constraint>,
-}
+/// forces, so a step that stops short of its tolerance reads a wrong force): the steps' counts
+/// and their largest violation, [`crate::step::SolveStats`].
+pub use crate::step::SolveStats;
 
-impl SolveStats {
-    /// One step, counted.
-    fn step(
-        &mut self,
-        solver: &mut Solver,
-        cloth: &Cloth,
-        state: &mut ClothState,
-        params: &StepParams,
-    ) -> Result<(), StepError> {
-        let r = solver.step(cloth, state, params)?;
-        self.steps += 1;
-        if !r.shape_converged {
-            self.unconverged += 1;
-        }
-        if r.violation > self.worst_violation {
-            self.worst_violation = r.violation;
-            self.worst = r.worst;
-        }
-        Ok(())
-    }
+/// One step of a virtual test, counted in `stats`.
+fn counted_step(
+    stats: &mut SolveStats,
+    solver: &mut Solver,
+    cloth: &Cloth,
+    state: &mut ClothState,
+    params: &StepParams,
+) -> Result<(), StepError> {
+    let start = state.time;
+    let r = solver.step(cloth, state, params)?;
+    stats.add(&r, params, start);
+    Ok(())
 }
 
 /// The sum of the forces the last step's constraints exerted on `nodes` (N) and their moment
@@ -346,7 +329,7 @@ pub fn fb1_tensile_test(
                        strain: f64|
      -> Result<f64, KesError> {
         place_clamp(cloth, &top, V3::new(0.0, strain * gauge, 0.0))?;
-        stats.step(solver, cloth, state, &params)?;
+        counted_step(&mut stats, solver, cloth, state, &params)?;
         let (f, _) = clamp_reaction(solver, params.dt, &state.positions, &top, V3::zeros());
         // The specimen pulls the top clamp back (−y): the instrument reads that pull.
         Ok(-f.y / width)
@@ -576,7 +559,7 @@ pub fn shear_test(
                        y: f64|
      -> Result<(f64, f64), KesError> {
         place_clamp(cloth, &top, V3::new(d, y - gauge, 0.0))?;
-        stats.step(solver, cloth, state, &params)?;
+        counted_step(&mut stats, solver, cloth, state, &params)?;
         let (f, _) = clamp_reaction(solver, params.dt, &state.positions, &top, V3::zeros());
         // The shear force: what holds the clamp against the specimen along its motion (the
         // specimen pulls it back, −x); the pull across the clamps (−y).
@@ -669,6 +652,8 @@ pub struct BendingCurve {
     pub cloth: Cloth,
     /// Its state.
     pub state: ClothState,
+    /// Time step, s (5 s over the steps per leg: the KES rate of 0.5 cm⁻¹/s).
+    pub dt: f64,
     /// Steps taken.
     pub steps: usize,
     /// How well the steps met their constraints.
@@ -760,7 +745,7 @@ pub fn bending_test(
     let mut max_force: f64 = 0.0;
     for (pass, k) in path {
         let edge = place_moving(&mut cloth, k)?;
-        stats.step(&mut solver, &cloth, &mut state, &params)?;
+        counted_step(&mut stats, &mut solver, &cloth, &mut state, &params)?;
         let (f, m) = clamp_reaction(&solver, dt, &state.positions, &moving, edge);
         max_force = max_force.max(f.norm() / width);
         // The specimen's moment on the clamp about x; the instrument holds it with the opposite.
@@ -801,6 +786,7 @@ pub fn bending_test(
         max_clamp_force: max_force,
         cloth,
         state,
+        dt,
         steps: stats.steps,
         stats,
     })

@@ -35,6 +35,6 @@ pub use params::{
 pub use shear_angle::ShearMeasure;
 pub use state::ClothState;
 pub use step::{
-    CollisionHook, HookContext, NoCollision, Solver, Stage, StageTimings, StepError, StepReport,
-    Tie,
+    CollisionHook, HookContext, NoCollision, SolveStats, Solver, Stage, StageTimings, StepError,
+    StepReport, Tie,
 };

@@ -46,7 +46,7 @@ use crate::state::ClothState;
 pub(crate) use hook::plane_push;
 pub use hook::{CollisionHook, HookContext, NoCollision, Tie};
 pub use projection::Constraint;
-pub use report::{Stage, StageTimings, StepError, StepReport};
+pub use report::{SolveStats, Stage, StageTimings, StepError, StepReport};
 
 use par::PAR_MIN;
 use report::{guard_edges, guard_nodes};

@@ -166,6 +166,48 @@ pub struct StepReport {
     pub timings: StageTimings,
 }
 
+/// Counts a run's steps as they are taken: how many, how many did not converge, and the
+/// largest violation one ended with (the runners that keep their steps' reports to themselves
+/// hand this out: the virtual KES instruments, `crate::kes`; the PARTY runs of wet scenes,
+/// `crate::wet::scene::run`). A step that failed is not counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveStats {
+    /// Steps taken.
+    pub steps: usize,
+    /// Steps that did not meet every tolerance ([`StepReport::converged`] false: the shape
+    /// stage's, the internal forces' or the implicit bending solve's).
+    pub unconverged: usize,
+    /// Of those, steps whose shape stage stopped above its tolerance
+    /// ([`StepReport::shape_converged`] false).
+    pub shape_unconverged: usize,
+    /// The largest violation a step ended with (relative strain, rad; NaN once a step ended
+    /// with NaN).
+    pub worst_violation: f64,
+    /// The constraint that had it.
+    pub worst: Option<Constraint>,
+    /// Simulated time at the start of that step, s.
+    pub worst_time: f64,
+    /// The shape tolerance the steps were held to (`StepParams::shape_tolerance` of the last
+    /// step counted).
+    pub tolerance: f64,
+}
+
+impl SolveStats {
+    /// Count one step's `report`, taken with `params` from simulated time `start_time`.
+    pub fn add(&mut self, report: &StepReport, params: &StepParams, start_time: f64) {
+        self.steps += 1;
+        self.unconverged += usize::from(!report.converged);
+        self.shape_unconverged += usize::from(!report.shape_converged);
+        self.tolerance = params.shape_tolerance;
+        // A NaN violation becomes the worst (and stays: nothing compares above it).
+        if report.violation.is_nan() || report.violation > self.worst_violation {
+            self.worst_violation = report.violation;
+            self.worst = report.worst;
+            self.worst_time = start_time;
+        }
+    }
+}
+
 /// The checks before a step: parameters in range, a state that matches the cloth, finite
 /// positions and velocities.
 pub(super) fn check_input(
@@ -244,5 +286,54 @@ fn non_finite(
             time,
         }),
         None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solve_stats_count_unconverged_steps_and_keep_the_worst() {
+        let params = StepParams {
+            shape_tolerance: 1e-6,
+            ..StepParams::default()
+        };
+        let report = |converged, shape_converged, violation, worst| StepReport {
+            converged,
+            shape_converged,
+            violation,
+            worst,
+            ..StepReport::default()
+        };
+        let mut s = SolveStats::default();
+        s.add(
+            &report(true, true, 1e-7, Some(Constraint::Edge(1))),
+            &params,
+            0.0,
+        );
+        s.add(
+            &report(false, false, 3e-5, Some(Constraint::Cell(4))),
+            &params,
+            0.01,
+        );
+        s.add(
+            &report(false, true, 2e-7, Some(Constraint::Edge(2))),
+            &params,
+            0.02,
+        );
+        assert_eq!((s.steps, s.unconverged, s.shape_unconverged), (3, 2, 1));
+        assert_eq!(s.worst_violation.to_bits(), 3e-5_f64.to_bits());
+        assert_eq!(s.worst, Some(Constraint::Cell(4)));
+        assert_eq!(s.worst_time.to_bits(), 0.01_f64.to_bits());
+        assert_eq!(s.tolerance.to_bits(), 1e-6_f64.to_bits());
+        s.add(&report(false, false, f64::NAN, None), &params, 0.03);
+        s.add(
+            &report(true, true, 1.0, Some(Constraint::Edge(3))),
+            &params,
+            0.04,
+        );
+        assert!(s.worst_violation.is_nan() && s.worst.is_none());
+        assert_eq!(s.worst_time.to_bits(), 0.03_f64.to_bits());
     }
 }

@@ -27,7 +27,7 @@ use crate::cloth::{Cloth, ClothError, ClothOptions, PinMotion};
 use crate::metrics::{FoldPeak, NodeCountParams, fold_peaks};
 use crate::params::{ParamError, StepParams};
 use crate::state::ClothState;
-use crate::step::{Solver, StepError};
+use crate::step::{SolveStats, Solver, StepError};
 
 type V3 = Vector3<f64>;
 
@@ -303,6 +303,9 @@ pub struct WetRun {
     pub frames: Vec<(f64, Vec<V3>)>,
     /// The failed step, if one failed.
     pub failure: Option<WetFailure>,
+    /// Whether the steps converged (the PARTY step's reports, counted); none for Yamada's
+    /// model, which has no tolerance to meet.
+    pub stats: Option<SolveStats>,
 }
 
 /// Folds around a point, from the cloth's height on a circle around it.
@@ -734,6 +737,10 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
     let (mut wall, mut pressure_wall) = (Duration::ZERO, Duration::ZERO);
     let mut failure = None;
     let mut taken = 0;
+    let mut stats = match solver {
+        WetSolver::Yamada(_) => None,
+        WetSolver::Party(_) => Some(SolveStats::default()),
+    };
     for _ in 0..steps {
         while let Some(&(t, node)) = releases.first() {
             if t > state.time + 0.5 * dt {
@@ -758,9 +765,15 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
                 solver,
                 params,
                 hook,
-            } => solver
-                .step_with(&cloth, &mut state, params, hook)
-                .map(|r| pressure_wall += r.timings.pressure),
+            } => {
+                let start = state.time;
+                solver.step_with(&cloth, &mut state, params, hook).map(|r| {
+                    pressure_wall += r.timings.pressure;
+                    if let Some(s) = stats.as_mut() {
+                        s.add(&r, params, start);
+                    }
+                })
+            }
         };
         wall += t0.elapsed();
         if let Err(error) = result {
@@ -814,6 +827,7 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
         bubbles,
         frames,
         failure,
+        stats,
     })
 }
 
@@ -966,4 +980,51 @@ pub fn largest_dt_where(
         }
     }
     Ok(Some(a.exp()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn satin() -> Fabric {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/fabrics/polyester_satin_wet.ron");
+        Fabric::load(&path).expect("fixture")
+    }
+
+    /// A PARTY run counts every step's report (0.05 s at 5 ms: 10 steps); Yamada's model has
+    /// none to count.
+    #[test]
+    fn party_runs_count_their_steps_reports() {
+        let fabric = satin();
+        let scene = WetScene {
+            particles: 6,
+            picks: vec![Pick {
+                at: [0.5, 0.5],
+                by: [0.0, 0.0, 0.01],
+                start: 0.0,
+                speed: 0.05,
+                release: None,
+            }],
+            duration: 0.05,
+            ..WetScene::default()
+        };
+        let params = StepParams {
+            dt: 0.005,
+            ..StepParams::default()
+        };
+        let party = run(&scene, &fabric, &WetSolver::Party(params.clone())).expect("runs");
+        let stats = party.stats.expect("the PARTY step's stats");
+        assert!(party.failure.is_none());
+        assert_eq!((stats.steps, party.steps), (10, 10));
+        assert!(stats.unconverged <= stats.steps && stats.shape_unconverged <= stats.unconverged);
+        assert!(stats.worst_violation.is_finite());
+        assert_eq!(stats.tolerance.to_bits(), params.shape_tolerance.to_bits());
+        let yamada = WetSolver::Yamada(YamadaParams::default());
+        let short = WetScene {
+            duration: 0.001,
+            ..scene
+        };
+        assert!(run(&short, &fabric, &yamada).expect("runs").stats.is_none());
+    }
 }

@@ -41,7 +41,7 @@ fn shear(name: &str, f: &Fabric, protocol: &ShearProtocol) -> ShearValues {
         100.0 * c.tension_error,
         100.0 * c.tension_rms_error,
         c.steps,
-        c.stats.unconverged,
+        c.stats.shape_unconverged,
         c.stats.worst_violation,
         c.stats.worst,
         clock.elapsed()
@@ -198,7 +198,7 @@ fn virtual_kes_tensile_test_recovers_emt_lt_wt_rt() {
             100.0 * got.rt,
             100.0 * input.rt,
             curve.steps,
-            curve.stats.unconverged,
+            curve.stats.shape_unconverged,
             clock.elapsed()
         );
         for (what, a, b) in [
@@ -237,7 +237,7 @@ fn bending(name: &str, direction: Direction, per_leg: usize) -> ((f64, f64), (f6
         units::moment_to_kes(input.1),
         curve.max_clamp_force,
         curve.steps,
-        curve.stats.unconverged,
+        curve.stats.shape_unconverged,
         curve.stats.worst_violation,
         curve.stats.worst,
         clock.elapsed()
