@@ -99,7 +99,11 @@ mod tests {
                     let fd = (turn_and_gradient(&axis, &a[0], &a[1], &a[2]).0
                         - turn_and_gradient(&axis, &b[0], &b[1], &b[2]).0)
                         / (2.0 * h);
-                    assert!((fd - g[k][d]).abs() < 1e-6, "point {k} axis {d}: {fd} vs {}", g[k][d]);
+                    assert!(
+                        (fd - g[k][d]).abs() < 1e-6,
+                        "point {k} axis {d}: {fd} vs {}",
+                        g[k][d]
+                    );
                 }
             }
         }

@@ -303,10 +303,12 @@ impl Cloth {
                 phase_slot[e as usize] = k as u32;
             }
         }
-        let shear = fabric.material_shear_loop().map_err(|source| ClothError::Material {
-            fabric: fabric.name.clone(),
-            source,
-        })?;
+        let shear = fabric
+            .material_shear_loop()
+            .map_err(|source| ClothError::Material {
+                fabric: fabric.name.clone(),
+                source,
+            })?;
         let locking_angle = fabric
             .shear
             .as_ref()

@@ -27,10 +27,10 @@ use rayon::prelude::*;
 use atelier_fabric::{Branch, MaterialTable, TensileState};
 
 use super::{Tie, plane_push};
+use crate::bend_angle::turn_and_gradient;
 use crate::cloth::Cloth;
 use crate::dual::{DualError, DualSystem, NONE, NodeWeight, Preconditioner, SLOTS};
 use crate::params::{ConstraintKind, ShapeMethod};
-use crate::bend_angle::turn_and_gradient;
 use crate::shear_angle::{ShearMeasure, cell_angle_gradient};
 
 type V3 = Vector3<f64>;
@@ -603,7 +603,10 @@ impl ShapeSolver {
         let dt2 = dt * dt;
         let row = |(r, ((((g, c), (extra, row_scale)), b), viol)): (
             usize,
-            ((((&mut [V3], &mut f64), (&mut f64, &mut f64)), &mut f64), &mut f64),
+            (
+                (((&mut [V3], &mut f64), (&mut f64, &mut f64)), &mut f64),
+                &mut f64,
+            ),
         )| {
             for gk in g.iter_mut() {
                 *gk = V3::zeros();
@@ -671,13 +674,7 @@ impl ShapeSolver {
                     for k in 0..3 {
                         g[slot[k] as usize] += grad[k];
                     }
-                    (
-                        theta - bend.offset,
-                        bend.compliance / dt2,
-                        false,
-                        1.0,
-                        true,
-                    )
+                    (theta - bend.offset, bend.compliance / dt2, false, 1.0, true)
                 }
                 RowKind::Tie(t) => {
                     let tie = &ties[tie_index[t as usize] as usize];
@@ -948,7 +945,8 @@ impl ShapeSolver {
             // them (pushing the member alone and collapsing again would move the group by
             // only its share, and repeated projections would drift it outwards).
             let r = self.root[i] as usize;
-            let members = &self.members[self.member_ptr[r] as usize..self.member_ptr[r + 1] as usize];
+            let members =
+                &self.members[self.member_ptr[r] as usize..self.member_ptr[r + 1] as usize];
             if members.len() > 1 {
                 for &k in members {
                     if inv[k as usize] > 0.0 {

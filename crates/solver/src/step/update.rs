@@ -7,9 +7,9 @@ use super::Solver;
 use super::StepError;
 use super::bending::regularised;
 use super::par::fill;
+use crate::bend_angle::turn_and_gradient;
 use crate::cloth::Cloth;
 use crate::params::{BendingModel, ConstraintKind, StepParams, Tension};
-use crate::bend_angle::turn_and_gradient;
 use crate::shear_angle::cell_angle;
 use crate::state::ClothState;
 

@@ -79,7 +79,10 @@ fn the_shooting_elastica_reproduces_the_reference_table() {
     assert!((l415 / 8.00420 - 1.0).abs() < 1e-5, "41.5°: λ {l415}");
     assert!((l45 / 9.25381 - 1.0).abs() < 1e-5, "45°: λ {l45}");
     let tip = *heavy_elastica(8.00420, 4000).last().expect("tip");
-    assert!((tip.0 - 0.7243).abs() < 1e-4 && (tip.1 - 0.6408).abs() < 1e-4, "{tip:?}");
+    assert!(
+        (tip.0 - 0.7243).abs() < 1e-4 && (tip.1 - 0.6408).abs() < 1e-4,
+        "{tip:?}"
+    );
     let small = heavy_elastica(0.01, 4000).last().expect("tip").1;
     assert!((small / (0.01 / 8.0) - 1.0).abs() < 1e-3, "{small}");
 }
@@ -205,8 +208,18 @@ fn heavy_fabric() -> Fabric {
 #[test]
 fn cantilever_refined_converges_to_the_elastica() {
     let cases: [(Fabric, Along, f64, &str); 4] = [
-        (fabric("cotton_broad"), Along::Warp, 41.5, "cotton broad, warp"),
-        (fabric("cotton_broad"), Along::Warp, 30.0, "cotton broad, warp"),
+        (
+            fabric("cotton_broad"),
+            Along::Warp,
+            41.5,
+            "cotton broad, warp",
+        ),
+        (
+            fabric("cotton_broad"),
+            Along::Warp,
+            30.0,
+            "cotton broad, warp",
+        ),
         (heavy_fabric(), Along::Warp, 45.0, "B 0.25, W 19, warp"),
         (heavy_fabric(), Along::Weft, 45.0, "B 0.15, W 19, weft"),
     ];
@@ -230,7 +243,10 @@ fn cantilever_refined_converges_to_the_elastica() {
                 rest.unconverged,
                 rest.steps
             );
-            assert!(rest.at_rest, "{label}, {segments} cells: not at rest: {rest:?}");
+            assert!(
+                rest.at_rest,
+                "{label}, {segments} cells: not at rest: {rest:?}"
+            );
             assert!(
                 rest.unconverged * 100 <= rest.steps,
                 "{label}, {segments} cells: {rest:?}"
@@ -259,7 +275,10 @@ fn cantilever_refined_converges_to_the_elastica() {
         "cantilever tolerance 1e-4 → 1e-5 (40 cells): {:.4}° → {:.4}°",
         loose.chord, tight.chord
     );
-    assert!((loose.chord - tight.chord).abs() <= 0.1, "{loose:?} {tight:?}");
+    assert!(
+        (loose.chord - tight.chord).abs() <= 0.1,
+        "{loose:?} {tight:?}"
+    );
 }
 
 /// With bending hysteresis (the default) the wool strip comes to rest, and it droops less than

@@ -108,7 +108,11 @@ struct Runs {
 
 impl Runs {
     fn median_dc(&self) -> f64 {
-        let mut v: Vec<f64> = self.runs.iter().map(|r| r.measure.drape_coefficient).collect();
+        let mut v: Vec<f64> = self
+            .runs
+            .iter()
+            .map(|r| r.measure.drape_coefficient)
+            .collect();
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     }
@@ -123,7 +127,11 @@ impl Runs {
             .iter()
             .map(|r| format!("{:.1}", r.measure.drape_coefficient))
             .collect();
-        let n: Vec<String> = self.runs.iter().map(|r| r.measure.nodes.to_string()).collect();
+        let n: Vec<String> = self
+            .runs
+            .iter()
+            .map(|r| r.measure.nodes.to_string())
+            .collect();
         format!("DC {} / nodes {}", dc.join(" "), n.join(" "))
     }
 }
@@ -168,11 +176,18 @@ fn table(title: &str, base: &DrapeScene, params: &StepParams, all: &[Runs]) -> S
         out,
         "| fabric | median DC % | Matsudaira DC % | error (points) | median nodes | Matsudaira | thesis (Ø 63.5) | per seed | settled | unconverged steps | largest violation | largest strain error | mean Newton its | ms/step |"
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        out,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for (f, r) in FABRICS.iter().zip(all) {
         let steps: usize = r.runs.iter().map(|x| x.steps).sum();
         let wall: f64 = r.runs.iter().map(|x| x.wall.as_secs_f64()).sum();
-        let its = r.runs.iter().map(|x| x.mean_shape_iterations * x.steps as f64).sum::<f64>()
+        let its = r
+            .runs
+            .iter()
+            .map(|x| x.mean_shape_iterations * x.steps as f64)
+            .sum::<f64>()
             / steps.max(1) as f64;
         let _ = writeln!(
             out,
@@ -190,7 +205,10 @@ fn table(title: &str, base: &DrapeScene, params: &StepParams, all: &[Runs]) -> S
             r.runs.iter().map(|x| x.unconverged_steps).sum::<usize>(),
             steps,
             r.runs.iter().map(|x| x.max_violation).fold(0.0, f64::max),
-            r.runs.iter().map(|x| x.max_strain_error).fold(0.0, f64::max),
+            r.runs
+                .iter()
+                .map(|x| x.max_strain_error)
+                .fold(0.0, f64::max),
             its,
             wall * 1e3 / steps.max(1) as f64,
         );
@@ -295,7 +313,12 @@ fn drape_thesis_protocol_dt_10ms_2s() {
     let all = run_all(&base, &params, &RestCriterion::fixed(2.0));
     eprintln!(
         "{}",
-        table("Thesis protocol (Δt 0.01 s, 2 s, not at rest)", &base, &params, &all)
+        table(
+            "Thesis protocol (Δt 0.01 s, 2 s, not at rest)",
+            &base,
+            &params,
+            &all
+        )
     );
     assert_converged(&all, "thesis disc");
     for &k in &THESIS_MET {

@@ -109,10 +109,20 @@ fn long_hanging_cloth_is_at_its_target_strains_and_rows_stay_level() {
 fn accelerated_internal_forces_need_fewer_iterations_than_steepest_descent() {
     // The internal-force phase runs only when the edges' forces come from the balance
     // (`Tension::Balance`); the default takes them implicitly in the shape stage.
-    let (_, _, fast, fast_res) =
-        hang_with(InternalMethod::Accelerated, 2.0, 200, false, Tension::Balance);
-    let (_, _, slow, slow_res) =
-        hang_with(InternalMethod::SteepestDescent, 2.0, 200, false, Tension::Balance);
+    let (_, _, fast, fast_res) = hang_with(
+        InternalMethod::Accelerated,
+        2.0,
+        200,
+        false,
+        Tension::Balance,
+    );
+    let (_, _, slow, slow_res) = hang_with(
+        InternalMethod::SteepestDescent,
+        2.0,
+        200,
+        false,
+        Tension::Balance,
+    );
     eprintln!(
         "hanging sheet, last second: accelerated {fast:.1} iterations/step (E/E₀ {fast_res:.1e}), steepest descent {slow:.1} (E/E₀ {slow_res:.1e})"
     );
@@ -189,8 +199,20 @@ fn a_100x100_sheet_pinned_at_two_corners_keeps_its_length() {
 /// takes the same shape with them, within 0.1 mm.
 #[test]
 fn long_range_attachments_change_no_shape_at_rest() {
-    let (_, without, ..) = hang_with(InternalMethod::Accelerated, 3.0, 30, false, Tension::default());
-    let (_, with, ..) = hang_with(InternalMethod::Accelerated, 3.0, 30, true, Tension::default());
+    let (_, without, ..) = hang_with(
+        InternalMethod::Accelerated,
+        3.0,
+        30,
+        false,
+        Tension::default(),
+    );
+    let (_, with, ..) = hang_with(
+        InternalMethod::Accelerated,
+        3.0,
+        30,
+        true,
+        Tension::default(),
+    );
     let worst = without
         .positions
         .iter()

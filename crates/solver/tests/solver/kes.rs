@@ -112,7 +112,11 @@ fn virtual_kes_shear_test_counts_the_pretension_twice_with_the_kes_g_in_the_cell
     let t = ShearProtocol::default().tension;
     for name in ["cotton_broad", "polyester_faille"] {
         let f = fabric(name);
-        let got = shear(name, &cells_with_the_kes_g(&f, t), &ShearProtocol::default());
+        let got = shear(
+            name,
+            &cells_with_the_kes_g(&f, t),
+            &ShearProtocol::default(),
+        );
         let want = shear_input(&f);
         eprintln!(
             "KES shear {name}, cells with the KES G: G {:.2} % off the fabric's KES G, {:.2} % off G + T; the \
