@@ -26,6 +26,10 @@ pub const STANDARD_GRAVITY: f64 = 9.80665;
 /// measurement (set `locking_angle_deg` in the fabric file when it is known).
 pub const DEFAULT_LOCKING_ANGLE: f64 = 40.0 * std::f64::consts::PI / 180.0;
 
+/// The KES-FB1 standard pretension, 10 gf/cm, in N/m; as a shear stiffness (its T·tan γ term
+/// per radian) it is 0.1745 gf/(cm·deg) of every published G.
+pub const KES_PRETENSION: f64 = 10.0 * units::FORCE_PER_WIDTH;
+
 /// KES shear values in SI (as the file gives them, or fitted to its measured loop), with the
 /// locking angle that bounds the trellis shear of the derived bias loop. [`Shear::to_loop`] is
 /// the angle-driven loop the cloth step uses.
@@ -59,9 +63,33 @@ impl Shear {
         })
     }
 
-    /// The reconstructed KES-FB1 loop of these values ([`ShearLoop::from_kes`]).
+    /// The reconstructed KES-FB1 loop of these values ([`ShearLoop::from_kes`]): the loop as
+    /// the instrument reads it, pretension term included.
     pub fn to_loop(&self) -> Result<ShearLoop, InvalidValue> {
         ShearLoop::from_kes(self.stiffness, self.hysteresis, self.hysteresis_5deg)
+    }
+
+    /// The fabric's own share of the loop: G less the pretension term T = [`KES_PRETENSION`]
+    /// (per radian) that every KES-FB1 reading contains (the specimen's warp, held at T between
+    /// the clamps and tilted by γ, pulls the clamp back by T·tan γ). The widths are untouched
+    /// (the term is elastic). In a cloth model the tensioned yarns supply that term themselves,
+    /// so the cells must carry only this loop. An `Inconsistent` error when G ≤ T (a KES G below
+    /// 0.1745 gf/(cm·deg) cannot have been read at the standard pretension).
+    pub fn to_material_loop(&self) -> Result<ShearLoop, InvalidValue> {
+        let g = self.stiffness - KES_PRETENSION;
+        if g <= 0.0 {
+            return Err(InvalidValue::new(
+                ErrorKind::Inconsistent,
+                "g",
+                format!(
+                    "G = {:.4} gf/(cm·deg) is not above the pretension term T·π/180 = {:.4} \
+                     gf/(cm·deg) that a KES-FB1 reading at 10 gf/cm contains",
+                    units::shear_stiffness_to_kes(self.stiffness),
+                    units::shear_stiffness_to_kes(KES_PRETENSION)
+                ),
+            ));
+        }
+        ShearLoop::from_kes(g, self.hysteresis, self.hysteresis_5deg)
     }
 
     /// Shear angle (rad) on loading at shear force per width `tau` (N/m): the bilinear KES loop
@@ -384,6 +412,18 @@ impl Fabric {
     pub fn shear_loop(&self) -> Result<ShearLoop, InvalidValue> {
         match &self.shear {
             Some(s) => s.to_loop().map_err(|e| e.within("shear")),
+            None => Ok(ShearCurve::from_fabric(self).to_loop()),
+        }
+    }
+
+    /// The loop the cloth's cells carry: [`Fabric::shear_loop`] less the KES pretension term
+    /// when the loop comes from KES-FB1 values or a measured FB1 record
+    /// ([`Shear::to_material_loop`]); a loop derived from the bias tensile branches has no such
+    /// term and is returned as it is. `docs/fabric.md` §9 and `docs/validation.md` (virtual KES
+    /// instruments) say why.
+    pub fn material_shear_loop(&self) -> Result<ShearLoop, InvalidValue> {
+        match &self.shear {
+            Some(s) => s.to_material_loop().map_err(|e| e.within("shear")),
             None => Ok(ShearCurve::from_fabric(self).to_loop()),
         }
     }

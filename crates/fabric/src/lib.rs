@@ -45,7 +45,8 @@ pub use bending::{
 };
 pub use error::{ErrorKind, FileError, InvalidValue, Position};
 pub use fabric::{
-    DEFAULT_LOCKING_ANGLE, Fabric, MAX_MONOTONE_REPAIR, MaterialTable, STANDARD_GRAVITY, Shear,
+    DEFAULT_LOCKING_ANGLE, Fabric, KES_PRETENSION, MAX_MONOTONE_REPAIR, MaterialTable,
+    STANDARD_GRAVITY, Shear,
     bias_from_shear, trellis_strain,
 };
 pub use plausibility::{FabricClass, PlausibilityWarning};
