@@ -46,8 +46,7 @@ pub use bending::{
 pub use error::{ErrorKind, FileError, InvalidValue, Position};
 pub use fabric::{
     DEFAULT_LOCKING_ANGLE, Fabric, KES_PRETENSION, MAX_MONOTONE_REPAIR, MaterialTable,
-    STANDARD_GRAVITY, Shear,
-    bias_from_shear, trellis_strain,
+    STANDARD_GRAVITY, Shear, bias_from_shear, trellis_strain,
 };
 pub use plausibility::{FabricClass, PlausibilityWarning};
 pub use shear::{
