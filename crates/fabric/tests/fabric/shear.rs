@@ -575,3 +575,36 @@ fn closed_paths_with_several_reversals_dissipate_energy() {
         assert!(w >= -1e-9 * scale, "path {a} → {turns:?}: work {w}");
     }
 }
+
+/// The cells' loop is the material's share of the KES loop: G less the pretension term of the
+/// KES-FB1 standard, 10 gf/cm per radian = 10·π/180 gf/(cm·deg) (computed here, not read from
+/// the crate), the widths unchanged; a G at or below the term is a typed error.
+#[test]
+fn the_material_loop_is_the_kes_loop_less_the_pretension_term() {
+    let term_kes = 10.0 * std::f64::consts::PI / 180.0;
+    for name in all_fixtures() {
+        let f = fixture(&name);
+        let s = f.shear.expect("shear");
+        let (kes, material) = (
+            f.shear_loop().expect("loop"),
+            f.material_shear_loop().expect("material loop"),
+        );
+        assert_relative_eq!(
+            units::shear_stiffness_to_kes(kes.stiffness() - material.stiffness()),
+            term_kes,
+            max_relative = 1e-12
+        );
+        let want = ShearLoop::from_kes(
+            s.stiffness - units::shear_stiffness_from_kes(term_kes),
+            s.hysteresis,
+            s.hysteresis_5deg,
+        )
+        .expect("valid");
+        assert_eq!(material, want, "{name}");
+    }
+    let mut f = fixture("denim");
+    f.shear.as_mut().expect("shear").stiffness = units::shear_stiffness_from_kes(0.9 * term_kes);
+    let e = f.material_shear_loop().expect_err("G below the term");
+    assert_eq!(e.kind, atelier_fabric::ErrorKind::Inconsistent, "{e}");
+    assert!(e.to_string().contains("shear"), "{e}");
+}
