@@ -32,7 +32,7 @@ pub const KES_PRETENSION: f64 = 10.0 * units::FORCE_PER_WIDTH;
 
 /// KES shear values in SI (as the file gives them, or fitted to its measured loop), with the
 /// locking angle that bounds the trellis shear of the derived bias loop. [`Shear::to_loop`] is
-/// the angle-driven loop the cloth step uses.
+/// the loop as KES-FB1 reads it; [`Shear::to_material_loop`] the share a cloth's cells carry.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shear {
     /// Shear stiffness G, N/(m·rad).
@@ -436,8 +436,8 @@ impl Fabric {
     /// The loop the cloth's cells carry: [`Fabric::shear_loop`] less the KES pretension term
     /// when the loop comes from KES-FB1 values or a measured FB1 record
     /// ([`Shear::to_material_loop`]); a loop derived from the bias tensile branches has no such
-    /// term and is returned as it is. `docs/fabric.md` §9 and `docs/validation.md` (virtual KES
-    /// instruments) say why.
+    /// term and is returned as it is. `docs/fabric.md` §9 ("The pretension term") and
+    /// `docs/validation.md` say why.
     pub fn material_shear_loop(&self) -> Result<ShearLoop, InvalidValue> {
         match &self.shear {
             Some(s) => s.to_material_loop().map_err(|e| e.within("shear")),
