@@ -16,6 +16,7 @@ pub mod cloth;
 pub mod contact;
 pub mod dual;
 pub mod kes;
+pub mod kkt;
 pub mod leg;
 pub mod long_range;
 pub mod metrics;

@@ -18,10 +18,14 @@ pub enum InternalMethod {
 /// How the shape constraints (49)–(51) are solved ([`crate::shape`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum ShapeMethod {
+    /// Full Newton on the saddle-point (KKT) system with the geometric stiffness of the rows in
+    /// tension ([`crate::kkt`]), factorized every iteration (faer LDLᵀ, symbolic analysis
+    /// reused while the rows are unchanged). The default.
+    Newton,
     /// Newton (fast projection, Goldenthal et al. 2007) on the constraint-space system, each
     /// linear solve by conjugate gradients preconditioned with a sparse LDLᵀ factorization
     /// (faer; symbolic analysis reused while the rows are unchanged), renewed when a solve needs
-    /// more than `refactor_after` CG iterations. The default.
+    /// more than `refactor_after` CG iterations (Gauss–Newton: no geometric stiffness).
     Direct {
         /// CG iterations above which the factorization is renewed (0: every Newton step).
         refactor_after: usize,
@@ -49,8 +53,8 @@ pub enum ShapeMethod {
 }
 
 impl ShapeMethod {
-    /// The default: [`ShapeMethod::Direct`] renewing its factorization after 4 CG iterations.
-    pub const DEFAULT: Self = Self::Direct { refactor_after: 4 };
+    /// The default: [`ShapeMethod::Newton`].
+    pub const DEFAULT: Self = Self::Newton;
 }
 
 /// Whether the axial edges resist compression.
@@ -139,7 +143,7 @@ pub struct StepParams {
     /// Iteration cap of the internal forces (a step whose forces stop at the cap says so in its
     /// report). Range ≥ 1; default 200 (warm-started, they usually need far fewer).
     pub internal_max_iterations: usize,
-    /// Shape-constraint method. Default `Direct { refactor_after: 4 }`.
+    /// Shape-constraint method. Default `Newton`.
     pub shape_method: ShapeMethod,
     /// Shape step γ of the Jacobi and Chebyshev methods: a row's correction times γ over the
     /// largest constraint count of its nodes. Range (0, 1]; default 1.
@@ -360,7 +364,7 @@ impl StepParams {
                 cg_iterations >= 1,
                 "≥ 1",
             )?,
-            ShapeMethod::Direct { .. } | ShapeMethod::Jacobi => {}
+            ShapeMethod::Newton | ShapeMethod::Direct { .. } | ShapeMethod::Jacobi => {}
         }
         if let TolerancePolicy::Adaptive {
             loose_factor,
