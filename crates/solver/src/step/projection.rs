@@ -499,7 +499,7 @@ impl ShapeSolver {
             .map(|&(a, b)| (a.min(b), a.max(b)))
             .collect();
         let edges = topo.edges();
-        let gathered: Vec<bool> = kinds
+        let mut gathered: Vec<bool> = kinds
             .iter()
             .map(|k| match k {
                 RowKind::Edge(e) => {
@@ -510,6 +510,48 @@ impl ShapeSolver {
                 _ => false,
             })
             .collect();
+        // Eased seams: edges that join the same two points of the garment once every seam is
+        // closed (the two sides' edges along a seam) are one seam line, whose length the
+        // shorter side sets; the longer ones gather (stretch-only), as a sewing machine eases
+        // the longer side in. Held at their own lengths, two edges of different rest lengths
+        // between the same points contradict each other: a sleeve cap 1.7 cm longer than its
+        // armhole never closed, and the edge along it was torn to 108 % strain.
+        let mut seam = root.clone();
+        for &(a, b) in &self.open_ties {
+            let (ra, rb) = (find(&mut seam, a), find(&mut seam, b));
+            if ra != rb {
+                seam[ra.max(rb) as usize] = ra.min(rb);
+            }
+        }
+        let mut shortest: std::collections::HashMap<(u32, u32), f64> =
+            std::collections::HashMap::new();
+        let seam_pair = |seam: &mut [u32], e: &atelier_grid::Edge| {
+            let (a, b) = (find(seam, e.a), find(seam, e.b));
+            (a.min(b), a.max(b))
+        };
+        let mut pair_of = vec![(NONE, NONE); kinds.len()];
+        let mut count_of: std::collections::HashMap<(u32, u32), u32> =
+            std::collections::HashMap::new();
+        for (r, k) in kinds.iter().enumerate() {
+            if let RowKind::Edge(e) = k {
+                let edge = &edges[*e as usize];
+                let key = seam_pair(&mut seam, edge);
+                pair_of[r] = key;
+                *count_of.entry(key).or_insert(0) += 1;
+                let l = shortest.entry(key).or_insert(f64::INFINITY);
+                *l = l.min(edge.rest_length);
+            }
+        }
+        for (r, k) in kinds.iter().enumerate() {
+            if let RowKind::Edge(e) = k {
+                let key = pair_of[r];
+                if count_of[&key] > 1
+                    && edges[*e as usize].rest_length > shortest[&key] * (1.0 + 1e-9)
+                {
+                    gathered[r] = true;
+                }
+            }
+        }
         // Row counts per node for the Jacobi scaling.
         let mut count = vec![0u32; n];
         for (r, nodes) in rows.iter().enumerate() {
