@@ -251,7 +251,8 @@ impl KktSystem {
             let Some((block, _)) = self.pair[r] else {
                 continue;
             };
-            if !(c > 0.0) {
+            // (NaN counts as no tension.)
+            if c.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 continue;
             }
             let (na, nb) = (self.slot_node[SLOTS * r], self.slot_node[SLOTS * r + 1]);
@@ -328,12 +329,12 @@ impl KktSystem {
             // d·(m s) = s/√w.
             let d = self.node_scale[i];
             let f = if weight[i].w > 0.0 { 1.0 / d } else { 0.0 };
-            for c in 0..3 {
-                self.rhs[3 * i + c] = f * s[i][c];
+            for (c, x) in s[i].iter().enumerate() {
+                self.rhs[3 * i + c] = f * x;
             }
         }
-        for r in 0..self.rows {
-            self.rhs[n3 + r] = self.row_scale[r] * b0[r];
+        for ((out, scale), b) in self.rhs[n3..].iter_mut().zip(&self.row_scale).zip(b0) {
+            *out = scale * b;
         }
         let ldlt = LdltRef::new(&self.symbolic, &self.factor);
         let dim = self.rhs.len();
