@@ -231,6 +231,15 @@ struct Structure {
     /// together (a dart closing at its apex gathers the cloth between the legs; held at its
     /// length the edge would make the tie unattainable).
     gathered: Vec<bool>,
+    /// Edge rows standing for their twins as well (both ends already one point each, so
+    /// the rows are one row repeated): the kept row's width as a multiple of its edge's own
+    /// (1 for every other row).
+    width_scale: Vec<f64>,
+    /// For an edge row retired as a twin, the row that stands for it (`NONE` otherwise).
+    twin_of: Vec<u32>,
+    /// The share of the standing row's force an edge row's own edge carries (1 for a row
+    /// without twins, 0 for a gathered twin).
+    force_share: Vec<f64>,
     /// Jacobi scaling: 1 / the largest row count over the row's nodes.
     local_scale: Vec<f64>,
     /// Rows in colours sharing no node (Gauss–Seidel), built on first use.
@@ -557,6 +566,56 @@ impl ShapeSolver {
                 }
             }
         }
+        // Twins already joined at both ends (a sewn seam's two sides) are the same row twice
+        // (the same two nodes, the same gradient): with rest lengths even 1e-4 apart they ask
+        // for two lengths at once, and the Newton step stalled at that difference (skirt: 2e-4
+        // against the 1e-4 tolerance, 200 iterations). One row stands for them: the shortest
+        // (which sets the seam line's length, as for eased seams), with the widths of the
+        // twins that are not gathered added to its own (parallel edges carry the seam line's
+        // tension together); the others retire.
+        let widths = cloth.edge_widths();
+        let mut width_scale = vec![1.0; kinds.len()];
+        let mut twin_of = vec![NONE; kinds.len()];
+        let mut by_ends: std::collections::HashMap<(u32, u32), Vec<usize>> =
+            std::collections::HashMap::new();
+        for (r, k) in kinds.iter().enumerate() {
+            if matches!(k, RowKind::Edge(_)) && !dead[r] {
+                let (a, b) = (rows[r][0], rows[r][1]);
+                by_ends.entry((a.min(b), a.max(b))).or_default().push(r);
+            }
+        }
+        let edge_of = |r: usize| match kinds[r] {
+            RowKind::Edge(e) => e as usize,
+            _ => unreachable!("edge rows only"),
+        };
+        for twins in by_ends.values().filter(|t| t.len() > 1) {
+            let keep = *twins
+                .iter()
+                .min_by(|&&x, &&y| {
+                    edges[edge_of(x)]
+                        .rest_length
+                        .total_cmp(&edges[edge_of(y)].rest_length)
+                        .then(x.cmp(&y))
+                })
+                .expect("two or more");
+            for &r in twins.iter().filter(|&&r| r != keep) {
+                dead[r] = true;
+                twin_of[r] = keep as u32;
+                if !gathered[r] {
+                    width_scale[keep] += widths[edge_of(r)] / widths[edge_of(keep)];
+                }
+            }
+        }
+        let force_share: Vec<f64> = (0..kinds.len())
+            .map(|r| match (kinds[r], twin_of[r]) {
+                (RowKind::Edge(_), NONE) => 1.0 / width_scale[r],
+                (RowKind::Edge(e), k) if !gathered[r] => {
+                    let k = k as usize;
+                    widths[e as usize] / (widths[edge_of(k)] * width_scale[k])
+                }
+                _ => 0.0,
+            })
+            .collect();
         // Row counts per node for the Jacobi scaling.
         let mut count = vec![0u32; n];
         for (r, nodes) in rows.iter().enumerate() {
@@ -586,6 +645,9 @@ impl ShapeSolver {
             row_nodes: rows,
             collapsed: dead.clone(),
             gathered,
+            width_scale,
+            twin_of,
+            force_share,
             dead,
             local_scale,
             colours: Vec::new(),
@@ -646,12 +708,13 @@ impl ShapeSolver {
         let pred = &self.pred;
         let topo = p.cloth.topology();
         let (edges, cells) = (topo.edges(), topo.cells());
-        let (kinds, corner_slot, dead, row_nodes, gathered) = (
+        let (kinds, corner_slot, dead, row_nodes, gathered, width_scale) = (
             &st.kinds,
             &st.corner_slot,
             &st.dead,
             &st.row_nodes,
             &st.gathered,
+            &st.width_scale,
         );
         let (grad, extras, weight, scales) = st.system.rows_mut();
         let spacing = &self.spacing;
@@ -688,7 +751,7 @@ impl ShapeSolver {
                     let l0 = edge.rest_length;
                     let (target, compliance) = match &p.tension {
                         Some(t) => {
-                            let w = t.widths[e as usize];
+                            let w = t.widths[e as usize] * width_scale[r];
                             let (eps, slope) = t.strain_and_slope(e as usize, -lam / (w * dt2));
                             (l0 * (1.0 + eps), l0 * slope / (w * dt2))
                         }
@@ -1341,7 +1404,13 @@ impl ShapeSolver {
         if let Some(st) = &self.structure {
             for (r, kind) in st.kinds.iter().enumerate() {
                 if let RowKind::Edge(e) = kind {
-                    out[*e as usize] = -self.lambda[r] / (dt * dt);
+                    // A row standing for its twins shares its force with them by width (the
+                    // same force per width in each); a retired twin gets its share here.
+                    let keep = match st.twin_of[r] {
+                        NONE => r,
+                        k => k as usize,
+                    };
+                    out[*e as usize] = -self.lambda[keep] * st.force_share[r] / (dt * dt);
                 }
             }
         }
