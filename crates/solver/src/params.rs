@@ -204,8 +204,9 @@ pub struct StepParams {
     /// false.
     pub long_range_attachments: bool,
     /// Divergence guard: a step whose result stretches or shrinks any edge by more than this
-    /// strain (|l/l⁰ − 1|) fails with `StepError::Diverged` and keeps the state. Range > 0;
-    /// default 1 (a doubled edge: far beyond any fabric's EMT).
+    /// strain (|l/l⁰ − 1|; a diagonal's change over its cell's size, the longest of the
+    /// diagonal and the cell's sides) fails with `StepError::Diverged` and keeps the state.
+    /// Range > 0; default 1 (a doubled edge: far beyond any fabric's EMT).
     pub divergence_strain: f64,
     /// Track hysteresis (tensile minor loops, bending spindle, shear loop) when the fabric has
     /// it. Default true; false uses the loading branch, the spindle's centre line and the shear
