@@ -128,7 +128,9 @@ impl EdgeTension<'_> {
                 l.strain(Branch::Loading, f)
             }
         };
-        let f = f.max(0.0);
+        if f < 0.0 {
+            return (at(0.0), 0.0);
+        }
         let h = 1e-6 * l.max_force() + 1e-3 * f;
         let eps = at(f);
         (eps, ((at(f + h) - eps) / h).max(0.0))
