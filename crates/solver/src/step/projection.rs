@@ -128,9 +128,7 @@ impl EdgeTension<'_> {
                 l.strain(Branch::Loading, f)
             }
         };
-        if f < 0.0 {
-            return (at(0.0), 0.0);
-        }
+        let f = f.max(0.0);
         let h = 1e-6 * l.max_force() + 1e-3 * f;
         let eps = at(f);
         (eps, ((at(f + h) - eps) / h).max(0.0))
