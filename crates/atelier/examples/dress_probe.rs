@@ -13,7 +13,7 @@ fn main() {
     let scene = Scene::load(spec, file.parent().unwrap()).expect("scene");
     let mut sim = Simulation::new(scene).expect("sim");
     let (mut steps, mut bad, mut worst) = (0, 0, 0.0f64);
-    let (mut inside, mut depth, mut iterations) = (0usize, 0.0f64, 0usize);
+    let (mut inside, mut depth, mut iterations, mut halved) = (0usize, 0.0f64, 0usize, 0usize);
     let wall = std::time::Instant::now();
     while sim.time() < until - 1e-9 {
         match sim.step() {
@@ -22,9 +22,10 @@ fn main() {
                 inside = inside.max(o.inside);
                 depth = depth.max(o.depth);
                 iterations += o.report.shape_iterations;
+                halved += usize::from(o.substeps > 1);
                 if !o.report.converged { bad += 1; worst = worst.max(o.report.violation); }
                 if std::env::var("PROBE_STEPS").is_ok() {
-                    println!("step t={:.2} it {} fact {} conv {} viol {:.1e} worst {:?} {:.2}s", sim.time(), o.report.shape_iterations, o.report.factorizations, o.report.converged, o.report.violation, o.report.worst, wall.elapsed().as_secs_f64());
+                    println!("step t={:.2} sub {} it {} fact {} conv {} viol {:.1e} worst {:?} {:.2}s", sim.time(), o.substeps, o.report.shape_iterations, o.report.factorizations, o.report.converged, o.report.violation, o.report.worst, wall.elapsed().as_secs_f64());
                 }
             }
             Ok(None) => break,
@@ -45,7 +46,7 @@ fn main() {
         }
     }
     let (sewn, all) = sim.sewing_progress();
-    println!("{steps} steps, {bad} unconverged (worst {worst:.2e}), {:.1} s wall, sewn at {:?}; {:.1} shape iterations per step; most nodes inside the body {inside} (deepest {:.1} mm)", wall.elapsed().as_secs_f64(), sim.sewn_at(), iterations as f64 / steps.max(1) as f64, depth * 1e3);
+    println!("{steps} steps, {bad} unconverged (worst {worst:.2e}), {:.1} s wall, sewn at {:?}; {:.1} shape iterations per step; most nodes inside the body {inside} (deepest {:.1} mm); {halved} steps taken again in parts", wall.elapsed().as_secs_f64(), sim.sewn_at(), iterations as f64 / steps.max(1) as f64, depth * 1e3);
     println!("t = {:.2} s, {sewn}/{all} sewn", sim.time());
     let unsewn = {
         let mut v = Vec::new();

@@ -121,6 +121,9 @@ pub struct StepOutcome {
     pub depth: f64,
     /// Wall time of the step's stages.
     pub timings: Timings,
+    /// The steps the cloth took to cover Δt: 1, or more when a PARTY step that ended above its
+    /// tolerance was taken again in halves (its report then sums them).
+    pub substeps: usize,
     /// The contact counts of the step (continuous-test candidates and hits, transfers, planes).
     pub contacts: atelier_collide::PassStats,
 }
@@ -492,65 +495,17 @@ impl Simulation {
         }
         let (t, dt) = (self.state.time, self.scene.settings.dt);
         let mut timings = Timings::default();
-        // 1. The body over this step.
         let moving = self.phase == Phase::Motion;
-        if moving && let Some(m) = &self.scene.motion {
-            let clock = Instant::now();
-            let tm = t - self.phase_start;
-            let (a, b) = (m.sample(tm), m.sample(tm + dt));
-            let body = &self.scene.body;
-            body.pose_into(&a, &mut self.posed);
-            body.pose_into(&b, &mut self.next_posed);
-            part_motions(body, &a, &mut self.motion_start);
-            part_motions(body, &b, &mut self.motion_end);
-            let set = self
-                .contact
-                .set_body(
-                    &self.posed.positions,
-                    &self.next_posed.positions,
-                    &self.surface_triangles,
-                    dt,
-                )
-                .and_then(|()| {
-                    self.contact
-                        .set_part_motion(&self.motion_start, &self.motion_end, dt)
-                });
-            if let Err(e) = set {
-                return Err(SimulationError {
-                    phase: self.phase,
-                    time: t,
-                    source: Failure::Body(e.to_string()),
-                });
-            }
-            timings.body = clock.elapsed();
-        }
-        // 2–9. The cloth step with its hooks: sewing, then the body.
         self.start_positions.clone_from(&self.state.positions);
-        let report = {
-            let mut hooks = Chain(vec![&mut self.sewing, &mut self.contact]);
-            let cloth = &self.scene.garment.cloth.cloth;
-            match &mut self.baseline {
-                Baseline::None => {
-                    self.solver
-                        .step_with(cloth, &mut self.state, &self.params, &mut hooks)
-                }
-                Baseline::Xpbd(solver, p) => solver
-                    .step_with(cloth, &mut self.state, p, &mut hooks)
-                    .map(baseline_step_report),
-                Baseline::MassSpring(solver, p) => solver
-                    .step_with(cloth, &mut self.state, p, &mut hooks)
-                    .map(baseline_step_report),
-            }
-        }
-        .map_err(|e| SimulationError {
-            phase: self.phase,
-            time: t,
-            source: Failure::Step(e),
-        })?;
+        let (report, substeps) = self
+            .span(t - self.phase_start, dt, moving, RETRY_DEPTH, &mut timings)
+            .map_err(|source| SimulationError {
+                phase: self.phase,
+                time: t,
+                source,
+            })?;
+        self.params.dt = dt;
         timings.solver = report.timings;
-        if moving {
-            std::mem::swap(&mut self.posed, &mut self.next_posed);
-        }
         // Diagnostics: every node against the body at the end of the step.
         let clock = Instant::now();
         let parts = self.contact.parts().expect("set in new");
@@ -568,10 +523,132 @@ impl Simulation {
             inside,
             depth,
             timings,
+            substeps,
             contacts: self.contact.take_stats(),
         }))
     }
 }
+
+impl Simulation {
+    /// The cloth over `h` seconds from `tm` (the motion's clock): the body posed at both ends
+    /// when `moving`, then the cloth step with its hooks (sewing, then the body). A PARTY step
+    /// that ends above its tolerance is taken again from the same state as two steps of h/2
+    /// (to `depth` halvings; the state of the unhalved step is kept when a half fails): a
+    /// step that does not converge is not a result, and a shorter step is the honest way to
+    /// one that does. Its report: converged only when every part converged, counts summed.
+    fn span(
+        &mut self,
+        tm: f64,
+        h: f64,
+        moving: bool,
+        depth: u32,
+        timings: &mut Timings,
+    ) -> Result<(StepReport, usize), Failure> {
+        let before = (depth > 0 && matches!(self.baseline, Baseline::None))
+            .then(|| (self.state.clone(), self.posed.clone()));
+        let whole = self.cloth_step(tm, h, moving, timings)?;
+        let Some((state, posed)) = before.filter(|_| !whole.converged) else {
+            return Ok((whole, 1));
+        };
+        let after = (
+            std::mem::replace(&mut self.state, state),
+            std::mem::replace(&mut self.posed, posed),
+        );
+        let halves = self.span(tm, 0.5 * h, moving, depth - 1, timings).and_then(|a| {
+            self.span(tm + 0.5 * h, 0.5 * h, moving, depth - 1, timings)
+                .map(|b| (a, b))
+        });
+        match halves {
+            Ok(((a, na), (b, nb))) => {
+                let mut r = b;
+                r.converged = a.converged && b.converged;
+                r.shape_converged = a.shape_converged && b.shape_converged;
+                if a.violation > b.violation {
+                    (r.violation, r.worst) = (a.violation, a.worst);
+                }
+                r.shape_iterations += a.shape_iterations + whole.shape_iterations;
+                r.factorizations += a.factorizations + whole.factorizations;
+                r.linear_iterations += a.linear_iterations + whole.linear_iterations;
+                r.internal_iterations += a.internal_iterations + whole.internal_iterations;
+                r.max_strain_error = r.max_strain_error.max(a.max_strain_error);
+                r.timings = add_stages(&add_stages(&whole.timings, &a.timings), &b.timings);
+                Ok((r, na + nb))
+            }
+            Err(_) => {
+                (self.state, self.posed) = after;
+                Ok((whole, 1))
+            }
+        }
+    }
+
+    /// One cloth step of `h` seconds from `tm` (see [`Self::span`]).
+    fn cloth_step(
+        &mut self,
+        tm: f64,
+        h: f64,
+        moving: bool,
+        timings: &mut Timings,
+    ) -> Result<StepReport, Failure> {
+        if moving && let Some(m) = &self.scene.motion {
+            let clock = Instant::now();
+            let (a, b) = (m.sample(tm), m.sample(tm + h));
+            let body = &self.scene.body;
+            body.pose_into(&a, &mut self.posed);
+            body.pose_into(&b, &mut self.next_posed);
+            part_motions(body, &a, &mut self.motion_start);
+            part_motions(body, &b, &mut self.motion_end);
+            self.contact
+                .set_body(
+                    &self.posed.positions,
+                    &self.next_posed.positions,
+                    &self.surface_triangles,
+                    h,
+                )
+                .and_then(|()| {
+                    self.contact
+                        .set_part_motion(&self.motion_start, &self.motion_end, h)
+                })
+                .map_err(|e| Failure::Body(e.to_string()))?;
+            timings.body += clock.elapsed();
+        }
+        self.params.dt = h;
+        let mut hooks = Chain(vec![&mut self.sewing, &mut self.contact]);
+        let cloth = &self.scene.garment.cloth.cloth;
+        let report = match &mut self.baseline {
+            Baseline::None => self
+                .solver
+                .step_with(cloth, &mut self.state, &self.params, &mut hooks),
+            Baseline::Xpbd(solver, p) => solver
+                .step_with(cloth, &mut self.state, p, &mut hooks)
+                .map(baseline_step_report),
+            Baseline::MassSpring(solver, p) => solver
+                .step_with(cloth, &mut self.state, p, &mut hooks)
+                .map(baseline_step_report),
+        }
+        .map_err(Failure::Step)?;
+        if moving {
+            std::mem::swap(&mut self.posed, &mut self.next_posed);
+        }
+        Ok(report)
+    }
+}
+
+/// Two steps' stage times added.
+fn add_stages(a: &StageTimings, b: &StageTimings) -> StageTimings {
+    StageTimings {
+        bending: a.bending + b.bending,
+        internal: a.internal + b.internal,
+        velocity: a.velocity + b.velocity,
+        shape: a.shape + b.shape,
+        collision: a.collision + b.collision,
+        transfer: a.transfer + b.transfer,
+        update: a.update + b.update,
+        pressure: a.pressure + b.pressure,
+    }
+}
+
+/// Halvings of a PARTY step that ends above its tolerance (a step of Δt/4 at most).
+const RETRY_DEPTH: u32 = 2;
 
 impl Simulation {
     /// The nodes inside the body now.
