@@ -9,7 +9,9 @@ fn main() {
     let file = Path::new(&args[1]);
     let until: f64 = args.get(2).map_or(1.0, |s| s.parse().unwrap());
     let sc = Scenario::load(file).expect("scenario");
-    let ScenarioKind::Garment(spec) = &sc.kind else { panic!("garment") };
+    let ScenarioKind::Garment(spec) = &sc.kind else {
+        panic!("garment")
+    };
     let scene = Scene::load(spec, file.parent().unwrap()).expect("scene");
     let mut sim = Simulation::new(scene).expect("sim");
     let (mut steps, mut bad, mut worst) = (0, 0, 0.0f64);
@@ -23,36 +25,73 @@ fn main() {
                 depth = depth.max(o.depth);
                 iterations += o.report.shape_iterations;
                 halved += usize::from(o.substeps > 1);
-                if !o.report.converged { bad += 1; worst = worst.max(o.report.violation); }
+                if !o.report.converged {
+                    bad += 1;
+                    worst = worst.max(o.report.violation);
+                }
                 if std::env::var("PROBE_STEPS").is_ok() {
-                    println!("step t={:.2} sub {} it {} fact {} conv {} viol {:.1e} worst {:?} {:.2}s", sim.time(), o.substeps, o.report.shape_iterations, o.report.factorizations, o.report.converged, o.report.violation, o.report.worst, wall.elapsed().as_secs_f64());
+                    println!(
+                        "step t={:.2} sub {} it {} fact {} conv {} viol {:.1e} worst {:?} {:.2}s",
+                        sim.time(),
+                        o.substeps,
+                        o.report.shape_iterations,
+                        o.report.factorizations,
+                        o.report.converged,
+                        o.report.violation,
+                        o.report.worst,
+                        wall.elapsed().as_secs_f64()
+                    );
                 }
             }
             Ok(None) => break,
-            Err(e) => { println!("error {e}"); break; }
+            Err(e) => {
+                println!("error {e}");
+                break;
+            }
         }
     }
     let g = &sim.scene().garment.cloth;
     let topo = g.cloth.topology();
     let x = &sim.state().positions;
-    let strain = |e: &atelier_grid::topology::Edge| (x[e.b as usize] - x[e.a as usize]).norm() / e.rest_length - 1.0;
+    let strain = |e: &atelier_grid::topology::Edge| {
+        (x[e.b as usize] - x[e.a as usize]).norm() / e.rest_length - 1.0
+    };
     if let Ok(list) = std::env::var("PROBE_EDGE") {
-        let seam_nodes: std::collections::HashSet<u32> = g.pairs.iter().flat_map(|&(a, b)| [a, b]).collect();
+        let seam_nodes: std::collections::HashSet<u32> =
+            g.pairs.iter().flat_map(|&(a, b)| [a, b]).collect();
         for e in list.split(',') {
             let k: usize = e.parse().unwrap();
             let ed = &topo.edges()[k];
             let panel = g.offsets.iter().rposition(|&o| o <= ed.a).unwrap();
-            println!("edge {k}: {:?} nodes {} {} panel {panel} rest {:.4} strain {:+.4} seam nodes {} {} at {:?}", ed.kind, ed.a, ed.b, ed.rest_length, strain(ed), seam_nodes.contains(&ed.a), seam_nodes.contains(&ed.b), x[ed.a as usize]);
+            println!(
+                "edge {k}: {:?} nodes {} {} panel {panel} rest {:.4} strain {:+.4} seam nodes {} {} at {:?}",
+                ed.kind,
+                ed.a,
+                ed.b,
+                ed.rest_length,
+                strain(ed),
+                seam_nodes.contains(&ed.a),
+                seam_nodes.contains(&ed.b),
+                x[ed.a as usize]
+            );
         }
     }
     let (sewn, all) = sim.sewing_progress();
-    println!("{steps} steps, {bad} unconverged (worst {worst:.2e}), {:.1} s wall, sewn at {:?}; {:.1} shape iterations per step; most nodes inside the body {inside} (deepest {:.1} mm); {halved} steps taken again in parts", wall.elapsed().as_secs_f64(), sim.sewn_at(), iterations as f64 / steps.max(1) as f64, depth * 1e3);
+    println!(
+        "{steps} steps, {bad} unconverged (worst {worst:.2e}), {:.1} s wall, sewn at {:?}; {:.1} shape iterations per step; most nodes inside the body {inside} (deepest {:.1} mm); {halved} steps taken again in parts",
+        wall.elapsed().as_secs_f64(),
+        sim.sewn_at(),
+        iterations as f64 / steps.max(1) as f64,
+        depth * 1e3
+    );
     println!("t = {:.2} s, {sewn}/{all} sewn", sim.time());
     let unsewn = {
         let mut v = Vec::new();
         for (k, &(a, b)) in g.pairs.iter().enumerate() {
             let gap = (x[a as usize] - x[b as usize]).norm();
-            if gap > 2e-3 { v.push((k, a, b, gap)); }
+            if gap > 2e-3 {
+                v.push((k, a, b, gap));
+            }
         }
         v
     };
@@ -62,19 +101,36 @@ fn main() {
             let mut out = Vec::new();
             for &e in es {
                 let e = &topo.edges()[e as usize];
-                if e.kind.is_axial() { out.push(format!("{:+.3}", strain(e))); }
+                if e.kind.is_axial() {
+                    out.push(format!("{:+.3}", strain(e)));
+                }
             }
             out.join(" ")
         };
         let p = x[a as usize];
-        println!("{:>3} {:<28} gap {:5.1} mm at ({:+.3},{:+.3},{:+.3})  a: {}  b: {}", k, g.pair_names[k], gap * 1e3, p.x, p.y, p.z, s(a), s(b));
+        println!(
+            "{:>3} {:<28} gap {:5.1} mm at ({:+.3},{:+.3},{:+.3})  a: {}  b: {}",
+            k,
+            g.pair_names[k],
+            gap * 1e3,
+            p.x,
+            p.y,
+            p.z,
+            s(a),
+            s(b)
+        );
     }
     // Overall strain statistics by panel.
     let mut worst = vec![0.0f64; g.offsets.len()];
     for e in topo.edges() {
-        if !e.kind.is_axial() { continue; }
+        if !e.kind.is_axial() {
+            continue;
+        }
         let panel = g.offsets.iter().rposition(|&o| o <= e.a).unwrap();
         worst[panel] = worst[panel].max(strain(e));
     }
-    println!("largest axial strain per panel: {:?}", worst.iter().map(|w| format!("{w:.4}")).collect::<Vec<_>>());
+    println!(
+        "largest axial strain per panel: {:?}",
+        worst.iter().map(|w| format!("{w:.4}")).collect::<Vec<_>>()
+    );
 }

@@ -554,10 +554,12 @@ impl Simulation {
             std::mem::replace(&mut self.state, state),
             std::mem::replace(&mut self.posed, posed),
         );
-        let halves = self.span(tm, 0.5 * h, moving, depth - 1, timings).and_then(|a| {
-            self.span(tm + 0.5 * h, 0.5 * h, moving, depth - 1, timings)
-                .map(|b| (a, b))
-        });
+        let halves = self
+            .span(tm, 0.5 * h, moving, depth - 1, timings)
+            .and_then(|a| {
+                self.span(tm + 0.5 * h, 0.5 * h, moving, depth - 1, timings)
+                    .map(|b| (a, b))
+            });
         match halves {
             Ok(((a, na), (b, nb))) => {
                 let mut r = b;
@@ -615,9 +617,10 @@ impl Simulation {
         let mut hooks = Chain(vec![&mut self.sewing, &mut self.contact]);
         let cloth = &self.scene.garment.cloth.cloth;
         let report = match &mut self.baseline {
-            Baseline::None => self
-                .solver
-                .step_with(cloth, &mut self.state, &self.params, &mut hooks),
+            Baseline::None => {
+                self.solver
+                    .step_with(cloth, &mut self.state, &self.params, &mut hooks)
+            }
             Baseline::Xpbd(solver, p) => solver
                 .step_with(cloth, &mut self.state, p, &mut hooks)
                 .map(baseline_step_report),
