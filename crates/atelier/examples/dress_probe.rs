@@ -1,5 +1,7 @@
 //! Probe (not a test): run a garment scenario and print, for every unsewn pair, its gap and
-//! the strain of the axial edges at its two nodes.
+//! the strain of the axial edges at its two nodes, with the steps' convergence:
+//! `cargo run --release -p atelier --example dress_probe -- SCENARIO.ron [seconds]`
+//! (`PROBE_STEPS=1`: a line per step; `PROBE_EDGE=i,j,…`: where those edges are at the end).
 use atelier::scenario::{Scenario, ScenarioKind};
 use atelier::{Scene, Simulation};
 use std::path::Path;
