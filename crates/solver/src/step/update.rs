@@ -135,7 +135,7 @@ impl Solver {
             // The implicit model: each direction's curvature at the end of the step, the turn of
             // its grid line about the step's node normal over the mean rest length.
             let (axial, axial_edges, smats, edges, pos) = (
-                topo.axial_neighbours(),
+                cloth.bending_neighbours(),
                 topo.axial_edges(),
                 cloth.slot_materials(),
                 topo.edges(),
@@ -170,8 +170,11 @@ impl Solver {
             && !params.bending_off
             && params.bending_model == BendingModel::Thesis
         {
-            let (axial, smats, eta) =
-                (topo.axial_neighbours(), cloth.slot_materials(), &self.s.eta);
+            let (axial, smats, eta) = (
+                cloth.bending_neighbours(),
+                cloth.slot_materials(),
+                &self.s.eta,
+            );
             for (i, slots) in state.bending.iter_mut().enumerate() {
                 for (k, st) in slots.iter_mut().enumerate() {
                     if axial[i][k] != NO_NODE {

@@ -22,7 +22,7 @@ impl Solver {
     ) -> (usize, f64) {
         let dt = params.dt;
         let (mass, areas) = (cloth.masses(), cloth.topology().node_areas());
-        let axial = cloth.topology().axial_neighbours();
+        let axial = cloth.bending_neighbours();
         let implicit = params.implicit_bending
             && !params.bending_off
             && params.bending_model == BendingModel::Thesis;
