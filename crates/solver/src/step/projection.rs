@@ -24,7 +24,7 @@ use faer::Par;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use atelier_fabric::{Branch, MaterialTable, TensileState};
+use atelier_fabric::{Branch, MaterialTable, TensileLoop, TensileState};
 
 use super::{Tie, plane_push};
 use crate::bend_angle::turn_and_gradient;
@@ -55,6 +55,12 @@ const MAX_MOVE: f64 = 0.5;
 /// it the two rows' small contradiction is taken up by the tension of the shorter (measured on
 /// the skirt: easing every mismatch made 3 of 118 steps miss the tolerance instead of 1).
 const EASE_THRESHOLD: f64 = 0.01;
+
+/// Rounds of [`ShapeSolver::hold_entering`] per Newton step.
+const MAX_CONTACT_ROUNDS: usize = 1;
+
+/// A node within this fraction of its spacing in front of its plane lies on it.
+const ON_PLANE: f64 = 1e-3;
 
 /// Backtracking halvings of a Newton step before it is taken as it is.
 const LINE_SEARCH_HALVINGS: usize = 6;
@@ -115,23 +121,36 @@ pub struct EdgeTension<'a> {
 }
 
 impl EdgeTension<'_> {
-    /// The strain of edge `e` at force per width `f` (N/m) and dε/df there (by a forward
-    /// difference over a small part of the loop's range; 0 in compression, where the strain
-    /// does not change).
+    /// The strain of edge `e` at force per width `f` (N/m) and dε/df there ([`edge_strain`]).
     #[inline]
     fn strain_and_slope(&self, e: usize, f: f64) -> (f64, f64) {
         let l = self.table.tensile(self.materials[e]);
-        let at = |f: f64| {
-            if self.hysteresis {
-                self.states[e].strain(l, f)
-            } else {
-                l.strain(Branch::Loading, f)
-            }
-        };
-        let f = f.max(0.0);
-        let h = 1e-6 * l.max_force() + 1e-3 * f;
-        let eps = at(f);
-        (eps, ((at(f + h) - eps) / h).max(0.0))
+        edge_strain(l, self.hysteresis.then(|| &self.states[e]), f)
+    }
+}
+
+/// The strain of an axial edge at force per width `f` (N/m) on loop `l` (through its
+/// hysteresis `state`, or the loading branch), and dε/df there by a forward difference over a
+/// small part of the loop's range. In compression the loop's slope at zero force goes on (the
+/// linear toe continued below zero): the characteristic is then C¹ through zero, where a rigid
+/// compression side (slope 0) put a kink that the Newton iteration crossed back and forth,
+/// halving its steps on every edge near zero force. The compressive strains this allows stay
+/// below the cloth's buckling strain (cotton broad: toe modulus ≈ 2 kN/m, a 2 cm cell buckles
+/// at ≈ 0.3 N/m, a strain of ≈ 1.4e-4).
+#[inline]
+pub(super) fn edge_strain(l: &TensileLoop, state: Option<&TensileState>, f: f64) -> (f64, f64) {
+    let at = |f: f64| match state {
+        Some(st) => st.strain(l, f),
+        None => l.strain(Branch::Loading, f),
+    };
+    let fp = f.max(0.0);
+    let h = 1e-6 * l.max_force() + 1e-3 * fp;
+    let eps = at(fp);
+    let slope = ((at(fp + h) - eps) / h).max(0.0);
+    if f < 0.0 {
+        (eps + slope * f, slope)
+    } else {
+        (eps, slope)
     }
 }
 
@@ -290,6 +309,9 @@ pub struct ShapeSolver {
     /// Nodes held on their contact plane in the Newton system (their weight projected onto
     /// the plane), per root node.
     on_plane: Vec<bool>,
+    /// Nodes held on their plane for the rest of the step since a Newton step would have
+    /// carried them through it ([`ShapeSolver::hold_entering`]).
+    stuck: Vec<bool>,
     /// Symbolic analyses made (diagnostics).
     pub analyses: usize,
     /// The full Newton step per root node (m) and whether `apply` takes it.
@@ -416,6 +438,7 @@ impl ShapeSolver {
         }
         let rows = st.kinds.len();
         self.on_plane.clear();
+        self.stuck.clear();
         // The multipliers start at zero every step (XPBD); a warm start from the last step's
         // forces was tried and measured: it saved no iterations on the drape (6.2 per step
         // either way) and cost them on cotton (10 against 6.1).
@@ -495,7 +518,7 @@ impl ShapeSolver {
             push(RowKind::Tie(k as u32), &[a, b]);
         }
         if with_bends {
-            let axial = topo.axial_neighbours();
+            let axial = cloth.bending_neighbours();
             for (i, slots) in axial.iter().enumerate() {
                 for dir in 0..2u8 {
                     // Slots: +u, −u, +v, −v.
@@ -1095,6 +1118,7 @@ impl ShapeSolver {
         let n = self.root.len();
         if self.on_plane.len() != n {
             self.on_plane = vec![false; n];
+            self.stuck = vec![false; n];
         }
         let mut changed = false;
         for i in 0..n {
@@ -1104,8 +1128,18 @@ impl ShapeSolver {
             if plane.normal != V3::zeros() && st.system.weight[r].w > 0.0 {
                 let x = p.positions[i] + vel[i] * p.dt;
                 let d = (x - plane.point).dot(&plane.normal);
-                let pulled_off = st.system.jt_at(&self.lambda, r).dot(&plane.normal) > 0.0;
-                on = d <= 1e-6 * self.spacing[i] && !pulled_off;
+                // Released when the balance the rows' forces alone would give, x̃ + w Jᵀλ (the
+                // inertial prediction moved by the constraint forces), lies in front of the
+                // plane: the contact would have to pull. Releasing on the constraint forces'
+                // direction alone (Jᵀλ·n > 0) let a node whose inertia carries it into the
+                // body go, the Newton step moved it in, and the projection pushed it back:
+                // the step was then no descent direction for the rows at that node (a sewn
+                // armhole stalled at 4e-2 for 100 iterations).
+                let balance = p.positions[i]
+                    + self.base[i] * p.dt
+                    + st.system.jt_at(&self.lambda, r) * st.system.weight[r].w;
+                let pulled_off = (balance - plane.point).dot(&plane.normal) > 0.0;
+                on = d <= ON_PLANE * self.spacing[i] && (!pulled_off || self.stuck[i]);
             }
             if on != self.on_plane[i] {
                 self.on_plane[i] = on;
@@ -1123,6 +1157,33 @@ impl ShapeSolver {
             }
             st.system.invalidate();
         }
+    }
+
+    /// Hold on its plane every released node that lies on it and that the Newton step just
+    /// solved would carry behind it; whether any was.
+    fn hold_entering(&mut self, p: &ShapeProblem<'_>, vel: &[V3]) -> bool {
+        let Some(st) = self.structure.as_mut() else {
+            return false;
+        };
+        let mut changed = false;
+        for i in 0..self.root.len() {
+            let r = self.root[i] as usize;
+            let plane = &p.planes[i];
+            if self.on_plane[i] || plane.normal == V3::zeros() || st.system.weight[r].w <= 0.0 {
+                continue;
+            }
+            let d = (p.positions[i] + vel[i] * p.dt - plane.point).dot(&plane.normal);
+            if d <= ON_PLANE * self.spacing[i] && d + self.newton_dx[r].dot(&plane.normal) < 0.0 {
+                self.on_plane[i] = true;
+                self.stuck[i] = true;
+                st.system.weight[r].n = plane.normal;
+                changed = true;
+            }
+        }
+        if changed {
+            st.system.invalidate();
+        }
+        changed
     }
 
     /// Pins at their prescribed positions, groups collapsed, nodes pushed in front of their
@@ -1219,6 +1280,18 @@ impl ShapeSolver {
                 ShapeMethod::Newton => {
                     self.newton_step()?;
                     report.factorizations += 1;
+                    // A released node on its plane that the step would carry through it is held
+                    // after all and the step solved again (an active-set correction): the
+                    // projection would push it back, which the step did not foresee, and the
+                    // step would be no descent direction for the rows at that node.
+                    for round in 0..=MAX_CONTACT_ROUNDS {
+                        if !self.hold_entering(p, vel) || round == MAX_CONTACT_ROUNDS {
+                            break;
+                        }
+                        self.shift_towards_balance(p, vel, false);
+                        self.newton_step()?;
+                        report.factorizations += 1;
+                    }
                     true
                 }
                 ShapeMethod::Direct { refactor_after } => {

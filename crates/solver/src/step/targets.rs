@@ -2,14 +2,12 @@
 //! lengths from the tensile characteristics (thesis (25)), and each cell's shear constraint
 //! linearised about the start of the step from the fabric's shear loop (`method.md` §2b).
 
-use atelier_fabric::Branch;
-
 use atelier_grid::NO_NODE;
 
 use super::Solver;
 use super::bending::regularised;
 use super::par::fill;
-use super::projection::{CellShear, NodeBend};
+use super::projection::{CellShear, NodeBend, edge_strain};
 use crate::bend_angle::{turn_and_gradient, turn_axis};
 use crate::cloth::Cloth;
 use crate::params::{BendingModel, StepParams};
@@ -51,11 +49,7 @@ impl Solver {
                 return edge.rest_length;
             }
             let l = table.tensile(mats[e]);
-            let strain = if hysteresis {
-                tensile[e].strain(l, fpw[e])
-            } else {
-                l.strain(Branch::Loading, fpw[e])
-            };
+            let strain = edge_strain(l, hysteresis.then(|| &tensile[e]), fpw[e]).0;
             edge.rest_length * (1.0 + strain)
         });
         (0..edges.len())
@@ -121,7 +115,7 @@ impl Solver {
         let n = topo.node_count();
         self.s.node_bend.resize(2 * n, NodeBend::default());
         let (axial, axial_edges, areas, mats, table, edges) = (
-            topo.axial_neighbours(),
+            cloth.bending_neighbours(),
             topo.axial_edges(),
             topo.node_areas(),
             cloth.slot_materials(),
