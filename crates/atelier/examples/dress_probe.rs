@@ -19,6 +19,7 @@ fn main() {
     let (mut steps, mut bad, mut worst) = (0, 0, 0.0f64);
     let (mut inside, mut depth, mut iterations, mut halved) = (0usize, 0.0f64, 0usize, 0usize);
     let wall = std::time::Instant::now();
+    println!("inside at the start: {}", sim.inside_by_part());
     while sim.time() < until - 1e-9 {
         match sim.step() {
             Ok(Some(o)) => {
@@ -58,6 +59,34 @@ fn main() {
     let strain = |e: &atelier_grid::topology::Edge| {
         (x[e.b as usize] - x[e.a as usize]).norm() / e.rest_length - 1.0
     };
+    if let Ok(list) = std::env::var("PROBE_NODES") {
+        let rest = topo.rest_positions();
+        let axial = g.cloth.bending_neighbours();
+        for k in list.split(',') {
+            let i: usize = k.parse().unwrap();
+            for dir in 0..2 {
+                let (a, b) = (axial[i][2 * dir], axial[i][2 * dir + 1]);
+                if a == atelier_grid::NO_NODE || b == atelier_grid::NO_NODE {
+                    continue;
+                }
+                let p2 = |k: u32| nalgebra::Vector2::new(rest[k as usize][0], rest[k as usize][1]);
+                let (e1, e2) = (p2(i as u32) - p2(b), p2(a) - p2(i as u32));
+                let (f1, f2) = (x[i] - x[b as usize], x[a as usize] - x[i]);
+                let ang = |c: f64| c.clamp(-1.0, 1.0).acos().to_degrees();
+                let panel = g.offsets.iter().rposition(|&o| o as usize <= i).unwrap();
+                println!(
+                    "node {i} dir {dir} panel {panel}: rest turn {:.1}°, now {:.1}° (edges {:.4} {:.4}, rest {:.4} {:.4}) at {:?}",
+                    ang(e1.dot(&e2) / (e1.norm() * e2.norm())),
+                    ang(f1.dot(&f2) / (f1.norm() * f2.norm())),
+                    f1.norm(),
+                    f2.norm(),
+                    e1.norm(),
+                    e2.norm(),
+                    x[i]
+                );
+            }
+        }
+    }
     if let Ok(list) = std::env::var("PROBE_EDGE") {
         let seam_nodes: std::collections::HashSet<u32> =
             g.pairs.iter().flat_map(|&(a, b)| [a, b]).collect();
