@@ -131,27 +131,18 @@ impl EdgeTension<'_> {
 
 /// The strain of an axial edge at force per width `f` (N/m) on loop `l` (through its
 /// hysteresis `state`, or the loading branch), and dε/df there by a forward difference over a
-/// small part of the loop's range. In compression the loop's slope at zero force goes on (the
-/// linear toe continued below zero): the characteristic is then C¹ through zero, where a rigid
-/// compression side (slope 0) put a kink that the Newton iteration crossed back and forth,
-/// halving its steps on every edge near zero force. The compressive strains this allows stay
-/// below the cloth's buckling strain (cotton broad: toe modulus ≈ 2 kN/m, a 2 cm cell buckles
-/// at ≈ 0.3 N/m, a strain of ≈ 1.4e-4).
+/// small part of the loop's range (in compression the strain at zero force; the slope there is
+/// the toe's, which the Newton rows use as their compliance).
 #[inline]
 pub(super) fn edge_strain(l: &TensileLoop, state: Option<&TensileState>, f: f64) -> (f64, f64) {
     let at = |f: f64| match state {
         Some(st) => st.strain(l, f),
         None => l.strain(Branch::Loading, f),
     };
-    let fp = f.max(0.0);
-    let h = 1e-6 * l.max_force() + 1e-3 * fp;
-    let eps = at(fp);
-    let slope = ((at(fp + h) - eps) / h).max(0.0);
-    if f < 0.0 {
-        (eps + slope * f, slope)
-    } else {
-        (eps, slope)
-    }
+    let f = f.max(0.0);
+    let h = 1e-6 * l.max_force() + 1e-3 * f;
+    let eps = at(f);
+    (eps, ((at(f + h) - eps) / h).max(0.0))
 }
 
 /// What the shape stage works on in one step.
