@@ -131,32 +131,20 @@ impl EdgeTension<'_> {
 
 /// The strain of an axial edge at force per width `f` (N/m) on loop `l` (through its
 /// hysteresis `state`, or the loading branch), and dε/df there by a forward difference over a
-/// small part of the loop's range. In compression the strain leaves the zero-force strain with
-/// the toe's slope s₀ and levels off at [`COMPRESSION_STRAIN`] below it:
-/// ε(0) + δ·tanh(s₀f/δ). The characteristic is then smooth through zero — rigid in compression,
-/// it had a kink there that the Newton iteration crossed back and forth — while the cloth
-/// shrinks by at most δ, a tenth of the step's tolerance, whatever its tensile curve (the toe's
-/// slope continued without a limit made the drape depend on the tensile scale: `docs/solver.md`).
+/// small part of the loop's range (in compression the strain at zero force, and the toe's
+/// slope, which the Newton rows use as their compliance). Smoother forms of the compression
+/// side were tried and measured (`docs/solver.md`, "The tensile toe").
 #[inline]
 pub(super) fn edge_strain(l: &TensileLoop, state: Option<&TensileState>, f: f64) -> (f64, f64) {
     let at = |f: f64| match state {
         Some(st) => st.strain(l, f),
         None => l.strain(Branch::Loading, f),
     };
-    let fp = f.max(0.0);
-    let h = 1e-6 * l.max_force() + 1e-3 * fp;
-    let eps = at(fp);
-    let slope = ((at(fp + h) - eps) / h).max(0.0);
-    if f < 0.0 {
-        let t = (slope * f / COMPRESSION_STRAIN).tanh();
-        (eps + COMPRESSION_STRAIN * t, slope * (1.0 - t * t))
-    } else {
-        (eps, slope)
-    }
+    let f = f.max(0.0);
+    let h = 1e-6 * l.max_force() + 1e-3 * f;
+    let eps = at(f);
+    (eps, ((at(f + h) - eps) / h).max(0.0))
 }
-
-/// The most an edge shortens below its zero-force length in compression ([`edge_strain`]).
-const COMPRESSION_STRAIN: f64 = 1e-5;
 
 /// What the shape stage works on in one step.
 pub struct ShapeProblem<'a> {
