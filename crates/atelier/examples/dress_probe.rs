@@ -34,8 +34,9 @@ fn main() {
                 }
                 if std::env::var("PROBE_STEPS").is_ok() {
                     println!(
-                        "step t={:.2} sub {} it {} fact {} conv {} viol {:.1e} worst {:?} {:.2}s",
+                        "step t={:.2} inside {} sub {} it {} fact {} conv {} viol {:.1e} worst {:?} {:.2}s",
                         sim.time(),
+                        o.inside,
                         o.substeps,
                         o.report.shape_iterations,
                         o.report.factorizations,
