@@ -74,9 +74,6 @@ pub struct NodeWeight {
     pub w: f64,
     /// Unit normal of a plane the node may not leave, or zero.
     pub n: V3,
-    /// A second such normal, orthogonal to `n` (a sewn group whose members lie on two
-    /// planes: it moves along their intersection), or zero.
-    pub m: V3,
 }
 
 impl NodeWeight {
@@ -86,29 +83,8 @@ impl NodeWeight {
         if self.n == V3::zeros() {
             v * self.w
         } else {
-            (v - self.n * self.n.dot(v) - self.m * self.m.dot(v)) * self.w
+            (v - self.n * self.n.dot(v)) * self.w
         }
-    }
-
-    /// Hold the node on one more plane through it (normal `normal`, unit): the first sets
-    /// `n`, a second that is not parallel to it sets `m` (its part orthogonal to `n`); a third
-    /// or a parallel one adds nothing.
-    pub fn hold(&mut self, normal: V3) {
-        if self.n == V3::zeros() {
-            self.n = normal;
-        } else if self.m == V3::zeros() {
-            let m = normal - self.n * self.n.dot(&normal);
-            let len = m.norm();
-            if len > 1e-6 {
-                self.m = m / len;
-            }
-        }
-    }
-
-    /// Free the node from its planes.
-    pub fn release(&mut self) {
-        self.n = V3::zeros();
-        self.m = V3::zeros();
     }
 }
 
@@ -627,17 +603,14 @@ mod tests {
             NodeWeight {
                 w: 2.0,
                 n: V3::zeros(),
-                m: V3::zeros(),
             },
             NodeWeight {
                 w: 1.0,
                 n: V3::new(0.0, 0.0, 1.0),
-                m: V3::zeros(),
             },
             NodeWeight {
                 w: 0.5,
                 n: V3::zeros(),
-                m: V3::zeros(),
             },
         ];
         sys.extra = vec![0.1, 0.0, 0.3];
@@ -706,7 +679,6 @@ mod tests {
             NodeWeight {
                 w: 1.0,
                 n: V3::zeros(),
-                m: V3::zeros(),
             },
         ];
         sys.extra = vec![0.0, 0.0];
@@ -735,31 +707,5 @@ mod tests {
                 ..
             })
         ));
-    }
-
-    /// `NodeWeight::hold`: a second plane restricts the node to the intersection line; a
-    /// parallel one adds nothing; `release` frees it (reference: the projector onto n₁ × n₂).
-    #[test]
-    fn a_node_weight_holds_two_planes_and_ignores_a_parallel_one() {
-        let (n1, n2) = (V3::new(0.0, 0.0, 1.0), V3::new(0.6, 0.0, 0.8));
-        let mut w = NodeWeight {
-            w: 3.0,
-            ..NodeWeight::default()
-        };
-        w.hold(n1);
-        w.hold(n2);
-        let v = V3::new(0.3, -0.7, 0.2);
-        let line = n1.cross(&n2).normalize();
-        assert!((w.apply(&v) - line * line.dot(&v) * 3.0).norm() < 1e-14);
-        let mut p = NodeWeight {
-            w: 1.0,
-            ..NodeWeight::default()
-        };
-        p.hold(n1);
-        p.hold(-n1);
-        assert_eq!(p.m, V3::zeros());
-        assert!((p.apply(&v) - V3::new(0.3, -0.7, 0.0)).norm() < 1e-15);
-        p.release();
-        assert_eq!(p.apply(&v), v);
     }
 }

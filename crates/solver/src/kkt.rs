@@ -241,8 +241,7 @@ impl KktSystem {
             let plane = if w.w > 0.0 { PLANE_STIFFNESS } else { 0.0 };
             for (k, (a, b)) in LOWER.iter().enumerate() {
                 let identity = if a == b { 1.0 } else { 0.0 };
-                self.values[self.node_diag[i][k]] =
-                    identity + plane * (w.n[*a] * w.n[*b] + w.m[*a] * w.m[*b]);
+                self.values[self.node_diag[i][k]] = identity + plane * w.n[*a] * w.n[*b];
             }
         }
         // Geometric stiffness of rows in tension: c (I − nnᵀ) on both diagonal blocks, −c on
@@ -391,17 +390,14 @@ mod tests {
             NodeWeight {
                 w: 2.0,
                 n: V3::zeros(),
-                m: V3::zeros(),
             },
             NodeWeight {
                 w: 0.5,
                 n: V3::new(0.0, 0.0, 1.0),
-                m: V3::zeros(),
             },
             NodeWeight {
                 w: 1.0,
                 n: V3::zeros(),
-                m: V3::zeros(),
             },
         ];
         let tol = [0.0, 3.0, 0.0];
@@ -478,59 +474,5 @@ mod tests {
                 dl[r]
             );
         }
-    }
-
-    /// A node held on two planes (a sewn group whose members lie on two planes) moves only
-    /// along their intersection: the solved step has no part along either normal, while the
-    /// move it is asked for has (reference: the projection onto n₁ × n₂).
-    #[test]
-    fn a_node_held_on_two_planes_moves_along_their_intersection() {
-        let rows = [[0, 1, NONE, NONE]];
-        let mut sys = KktSystem::new(2, &rows, &[true]).unwrap();
-        let d = V3::new(1.0, 0.3, -0.2).normalize();
-        let grad = vec![-d, d, V3::zeros(), V3::zeros()];
-        let (n1, n2) = (V3::new(0.0, 0.0, 1.0), V3::new(0.0, 0.5, 1.0).normalize());
-        let mut held = NodeWeight {
-            w: 2.0,
-            ..NodeWeight::default()
-        };
-        held.hold(n1);
-        held.hold(n2);
-        let weight = [
-            held,
-            NodeWeight {
-                w: 1.0,
-                ..NodeWeight::default()
-            },
-        ];
-        sys.factorize(&KktValues {
-            grad: &grad,
-            extra: &[1e-3],
-            weight: &weight,
-            tension_over_length: &[0.0],
-        })
-        .unwrap();
-        let s = [V3::new(0.02, -0.03, 0.05), V3::new(0.01, 0.0, -0.02)];
-        let (mut dx, mut dl) = ([V3::zeros(); 2], [0.0]);
-        sys.solve(&weight, &s, &[0.004], &mut dx, &mut dl);
-        let line = n1.cross(&n2).normalize();
-        assert!(dx[0].norm() > 1e-3, "{:?}", dx[0]);
-        for n in [n1, n2] {
-            assert!(dx[0].dot(&n).abs() <= 1e-6 * dx[0].norm(), "{:?}", dx[0]);
-        }
-        assert!((dx[0].dot(&line).abs() - dx[0].norm()).abs() <= 1e-6 * dx[0].norm());
-        // Held on the first plane only, it leaves the second.
-        let mut once = held;
-        once.m = V3::zeros();
-        let weight = [weight[0], weight[1]].map(|w| if w.w == 2.0 { once } else { w });
-        sys.factorize(&KktValues {
-            grad: &grad,
-            extra: &[1e-3],
-            weight: &weight,
-            tension_over_length: &[0.0],
-        })
-        .unwrap();
-        sys.solve(&weight, &s, &[0.004], &mut dx, &mut dl);
-        assert!(dx[0].dot(&n2).abs() > 1e-3 * dx[0].norm(), "{:?}", dx[0]);
     }
 }

@@ -1140,15 +1140,11 @@ impl ShapeSolver {
         }
         if changed {
             for w in st.system.weight.iter_mut() {
-                w.release();
+                w.n = V3::zeros();
             }
-            // A sewn group is held on every plane a member of it lies on: held on one only,
-            // the step carried it through the other and the projection pushed it back (the
-            // step was then no descent direction for the rows there: a bending line through a
-            // dart's apex stalled the sewing dress for 100 iterations).
             for i in 0..n {
                 if self.on_plane[i] {
-                    st.system.weight[self.root[i] as usize].hold(p.planes[i].normal);
+                    st.system.weight[self.root[i] as usize].n = p.planes[i].normal;
                 }
             }
             st.system.invalidate();
@@ -1172,7 +1168,7 @@ impl ShapeSolver {
             if d <= ON_PLANE * self.spacing[i] && d + self.newton_dx[r].dot(&plane.normal) < 0.0 {
                 self.on_plane[i] = true;
                 self.stuck[i] = true;
-                st.system.weight[r].hold(plane.normal);
+                st.system.weight[r].n = plane.normal;
                 changed = true;
             }
         }
