@@ -1,7 +1,8 @@
 //! Probe (not a test): run a garment scenario and print, for every unsewn pair, its gap and
 //! the strain of the axial edges at its two nodes, with the steps' convergence:
 //! `cargo run --release -p atelier --example dress_probe -- SCENARIO.ron [seconds]`
-//! (`PROBE_STEPS=1`: a line per step; `PROBE_EDGE=i,j,…`: where those edges are at the end).
+//! (`PROBE_STEPS=1`: a line per step; `PROBE_EDGE=i,j,…`: where those edges are at the end;
+//! `PROBE_DUMP=FILE`: the final positions, one node per line).
 use atelier::scenario::{Scenario, ScenarioKind};
 use atelier::{Scene, Simulation};
 use std::path::Path;
@@ -53,6 +54,15 @@ fn main() {
                 break;
             }
         }
+    }
+    if let Ok(path) = std::env::var("PROBE_DUMP") {
+        let text: String = sim
+            .state()
+            .positions
+            .iter()
+            .map(|p| format!("{:.9} {:.9} {:.9}\n", p.x, p.y, p.z))
+            .collect();
+        std::fs::write(&path, text).expect("dump written");
     }
     let g = &sim.scene().garment.cloth;
     let topo = g.cloth.topology();
