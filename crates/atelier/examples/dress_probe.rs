@@ -2,7 +2,8 @@
 //! the strain of the axial edges at its two nodes, with the steps' convergence:
 //! `cargo run --release -p atelier --example dress_probe -- SCENARIO.ron [seconds]`
 //! (`PROBE_STEPS=1`: a line per step; `PROBE_EDGE=i,j,…`: where those edges are at the end;
-//! `PROBE_DUMP=FILE`: the final positions, one node per line).
+//! `PROBE_DUMP=FILE`: the final positions, one node per line; `PROBE_TOL=x`: the shape
+//! tolerance).
 use atelier::scenario::{Scenario, ScenarioKind};
 use atelier::{Scene, Simulation};
 use std::path::Path;
@@ -15,7 +16,10 @@ fn main() {
     let ScenarioKind::Garment(spec) = &sc.kind else {
         panic!("garment")
     };
-    let scene = Scene::load(spec, file.parent().unwrap()).expect("scene");
+    let mut scene = Scene::load(spec, file.parent().unwrap()).expect("scene");
+    if let Ok(t) = std::env::var("PROBE_TOL") {
+        scene.settings.step.shape_tolerance = t.parse().expect("PROBE_TOL: a number");
+    }
     let mut sim = Simulation::new(scene).expect("sim");
     let (mut steps, mut bad, mut worst) = (0, 0, 0.0f64);
     let (mut inside, mut depth, mut iterations, mut halved) = (0usize, 0.0f64, 0usize, 0usize);
