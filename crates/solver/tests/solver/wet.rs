@@ -177,7 +177,7 @@ fn the_party_step_takes_the_pressure_at_60_times_the_step() {
 
 /// Several bubbles: two shallow domes of air under a 45 cm cloth, 6 cm apart (each
 /// π·R²·h/3 = 11.3 cm³, air at atmospheric pressure) are two sealed pockets on the PARTY step;
-/// one pinched and lifted 4 mm,
+/// one pinched and lifted 1 mm,
 /// both keep their own air (K constant within 10⁻⁹, each about half of it) and Boyle's law
 /// holds in each at the end (within 10⁻³).
 #[test]
@@ -205,7 +205,12 @@ fn two_pockets_keep_their_own_air() {
         domes: vec![dome(0.3), dome(0.7)],
         picks: vec![Pick {
             at: [0.3, 0.5],
-            by: [0.0, 0.0, 0.004],
+            // 1 mm: a 4 mm lift of the sealed, inextensible dome pulls its pocket below
+            // atmospheric from 0.375 s (−2.95 Pa at 0.535 s, the other pocket at +1.37 Pa), and
+            // at 0.54 s the cloth sucked down splits it into two (three bubbles) — suction,
+            // which this test's bounds do not describe (docs/validation.md, "Wet pockets,
+            // session 8").
+            by: [0.0, 0.0, 0.001],
             start: 0.2,
             speed: 0.01,
             release: None,
