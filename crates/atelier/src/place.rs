@@ -396,19 +396,33 @@ pub fn place(
                 (a.min(rest[i][0]), b.max(rest[i][0]))
             });
         let from_width = params.ease * (wmax - wmin) / std::f64::consts::TAU;
+        // One radius for the whole panel (a cylinder keeps every pattern length): the limb's
+        // widest section over the panel's span, plus the clearance. Per-row radii stretched
+        // the edges between rows wherever the fit jumped (the upper arm's mesh has a ring of
+        // no vertices within the band 8–11 cm below the shoulder: radius 82 → 57 → 75 mm, the
+        // sleeve's edges there placed at twice their length and the first step snapping them
+        // back by 4.5 cm whatever its Δt).
+        let down = |i: usize| (y0 - rest[i][1]) + offset;
+        let (tmin, tmax) = r
+            .clone()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), i| {
+                (a.min(down(i)), b.max(down(i)))
+            });
+        let fit = limb_vertices
+            .iter()
+            .filter(|v| {
+                let t = (*v - origin).dot(&axis);
+                t > tmin - params.band && t < tmax + params.band
+            })
+            .map(|v| {
+                let d = v - origin;
+                (d - axis * d.dot(&axis)).norm()
+            })
+            .fold(0.0, f64::max);
+        let radius = (fit + params.clearance).max(from_width);
         for i in r {
-            let t = (y0 - rest[i][1]) + offset;
-            let fit = limb_vertices
-                .iter()
-                .filter(|v| ((*v - origin).dot(&axis) - t).abs() < params.band)
-                .map(|v| {
-                    let d = v - origin;
-                    (d - axis * d.dot(&axis)).norm()
-                })
-                .fold(0.0, f64::max);
-            let radius = (fit + params.clearance).max(from_width);
             let a = rest[i][0] / radius;
-            out[i] = origin + axis * t + (out_dir * a.cos() + plus_x * a.sin()) * radius;
+            out[i] = origin + axis * down(i) + (out_dir * a.cos() + plus_x * a.sin()) * radius;
         }
     }
     Ok(out)
