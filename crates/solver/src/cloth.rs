@@ -113,6 +113,8 @@ pub struct Cloth {
     materials: MaterialTable,
     edge_material: Vec<u32>,
     slot_material: Vec<[u32; SLOTS]>,
+    /// Axial neighbours of the grid lines that bend ([`Cloth::bending_neighbours`]).
+    bend_slots: Vec<[u32; SLOTS]>,
     edge_width: Vec<f64>,
     colours: usize,
     colour_edge: Vec<u32>,
@@ -283,7 +285,9 @@ impl Cloth {
                 diagonal_stiffness[d as usize] = g * l * l / (2.0 * cell.area);
             }
         }
+        let bend_slots = bending_lines(&topology);
         Ok(Self {
+            bend_slots,
             shear,
             diagonal_stiffness,
             topology,
@@ -306,6 +310,17 @@ impl Cloth {
             incidence: Vec::new(),
         }
         .with_incidence())
+    }
+
+    /// Each node's axial neighbours (+u, −u, +v, −v) on the grid lines that carry bending:
+    /// [`ClothTopology::axial_neighbours`] without the directions whose two neighbours turn by
+    /// more than [`BEND_LINE_MAX_TURN`] in the pattern ([`NO_NODE`] in both slots). Where the
+    /// gridder fans cells around a dart's apex, a node's "u" neighbours can sit at 100–125° to
+    /// each other; the turn of such a stencil about t̄ × n reads ±π on the flat panel (the
+    /// dress's bust-dart apexes: 4–5 rad at the placement), so it is no grid line and bends
+    /// nothing — its neighbours' lines carry the bending there.
+    pub fn bending_neighbours(&self) -> &[[u32; SLOTS]] {
+        &self.bend_slots
     }
 
     /// Pin `node` at `anchor` with `motion` (re-pinning a node replaces its pin).
@@ -540,4 +555,38 @@ impl Cloth {
     pub fn bending_hysteretic(&self) -> bool {
         (0..self.materials.len() as u32).any(|i| self.materials.bending(i).is_hysteretic())
     }
+}
+
+/// The largest turn, in the pattern plane, of a grid line through a node that still carries
+/// bending (60°: the line's turn then reads within a factor 2 of the fold about t̄ × n).
+pub const BEND_LINE_MAX_TURN: f64 = std::f64::consts::FRAC_PI_3;
+
+/// [`Cloth::bending_neighbours`] of `topology`.
+fn bending_lines(topology: &ClothTopology) -> Vec<[u32; SLOTS]> {
+    let rest = topology.rest_positions();
+    let min_cos = BEND_LINE_MAX_TURN.cos();
+    topology
+        .axial_neighbours()
+        .iter()
+        .enumerate()
+        .map(|(i, slots)| {
+            let mut out = *slots;
+            for dir in 0..2 {
+                let (after, before) = (slots[2 * dir], slots[2 * dir + 1]);
+                if after == NO_NODE || before == NO_NODE {
+                    continue;
+                }
+                let at = |k: u32| rest[k as usize];
+                let (b, p, a) = (at(before), rest[i], at(after));
+                let (e1, e2) = ([p[0] - b[0], p[1] - b[1]], [a[0] - p[0], a[1] - p[1]]);
+                let (l1, l2) = (e1[0].hypot(e1[1]), e2[0].hypot(e2[1]));
+                let cos = (e1[0] * e2[0] + e1[1] * e2[1]) / (l1 * l2);
+                if !(cos >= min_cos) {
+                    out[2 * dir] = NO_NODE;
+                    out[2 * dir + 1] = NO_NODE;
+                }
+            }
+            out
+        })
+        .collect()
 }

@@ -195,7 +195,7 @@ impl Hinge {
 pub(crate) fn fill_hinges(cloth: &Cloth, out: &mut Vec<Hinge>) {
     let topo = cloth.topology();
     let (axial, axial_edge, smats) = (
-        topo.axial_neighbours(),
+        cloth.bending_neighbours(),
         topo.axial_edges(),
         cloth.slot_materials(),
     );

@@ -34,7 +34,7 @@ impl Solver {
         }
         let topo = cloth.topology();
         let (axial, areas, mats, table) = (
-            topo.axial_neighbours(),
+            cloth.bending_neighbours(),
             topo.node_areas(),
             cloth.slot_materials(),
             cloth.materials(),

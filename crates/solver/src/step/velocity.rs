@@ -20,7 +20,7 @@ impl Solver {
     ) {
         let dt = params.dt;
         let (mass, areas) = (cloth.masses(), cloth.topology().node_areas());
-        let axial = cloth.topology().axial_neighbours();
+        let axial = cloth.bending_neighbours();
         let implicit = params.implicit_bending && !params.bending_off;
         let s = &mut self.s;
         let (f_m, normal) = (&s.f_m, &s.normal);
