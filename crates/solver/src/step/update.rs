@@ -85,8 +85,11 @@ impl Solver {
             }
         }
         if cloth.bending_hysteretic() && !params.bending_off {
-            let (axial, smats, eta) =
-                (cloth.bending_neighbours(), cloth.slot_materials(), &self.s.eta);
+            let (axial, smats, eta) = (
+                cloth.bending_neighbours(),
+                cloth.slot_materials(),
+                &self.s.eta,
+            );
             for (i, slots) in state.bending.iter_mut().enumerate() {
                 for (k, st) in slots.iter_mut().enumerate() {
                     if axial[i][k] != NO_NODE {
