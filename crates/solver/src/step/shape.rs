@@ -11,6 +11,10 @@ use crate::cloth::Cloth;
 use crate::params::{ShapeMethod, StepParams, Tension};
 use crate::state::ClothState;
 
+/// Collision passes a step may add to `StepParams::collision_passes` when the last one leaves
+/// a converged shape above its tolerance (`docs/solver.md`, "Extra collision passes").
+pub const EXTRA_PASSES: usize = 4;
+
 impl Solver {
     /// The shape stage of one step: for each collision pass, the constraints solved to
     /// `shape_tolerance × factor` (or `shape_max_iterations`), then the hook's pass; afterwards
@@ -34,7 +38,7 @@ impl Solver {
         self.prepare_long_range(cloth, params, local);
         let mut collision = Duration::ZERO;
         let mut pressure = Duration::ZERO;
-        let mut last = ShapeReport::default();
+        let mut last: ShapeReport;
         let tension = (params.tension == Tension::Constraint).then(|| EdgeTension {
             table: cloth.yarn_materials(),
             materials: cloth.edge_materials(),
@@ -42,7 +46,12 @@ impl Solver {
             states: &state.tensile,
             hysteresis: params.hysteresis && cloth.tensile_hysteretic(),
         });
-        for pass in 0..params.collision_passes {
+        // The thesis's passes, then up to `EXTRA_PASSES` more while the last pass's shape solve
+        // met the tolerance and its collision pass left the shape above it (a contact found or
+        // a seam drawn in that pass), each ending with its collision pass. A shape solve that
+        // did not converge is not given more passes: the caller halves the step instead.
+        let mut pass = 0;
+        let (violation, worst) = loop {
             let s = &mut self.s;
             let problem = ShapeProblem {
                 cloth,
@@ -95,25 +104,34 @@ impl Solver {
             self.collision_pass(cloth, state, dt, pass, hook);
             collision += tc.elapsed();
             guard_nodes(Stage::Collision, "velocity", &self.s.vel, time)?;
-        }
-        // What the step ends with, after the last collision pass.
-        let s = &mut self.s;
-        let problem = ShapeProblem {
-            cloth,
-            positions: &state.positions,
-            dt,
-            time,
-            damping: params.damping,
-            targets: &s.target,
-            tension,
-            axial: params.axial_constraint,
-            measure: params.shear_measure,
-            shear: &s.cell_shear,
-            bends: &s.node_bend,
-            ties: &s.ties,
-            planes: &s.planes,
+            pass += 1;
+            if pass < params.collision_passes {
+                continue;
+            }
+            // What the step ends with, after the last collision pass.
+            let s = &mut self.s;
+            let problem = ShapeProblem {
+                cloth,
+                positions: &state.positions,
+                dt,
+                time,
+                damping: params.damping,
+                targets: &s.target,
+                tension,
+                axial: params.axial_constraint,
+                measure: params.shear_measure,
+                shear: &s.cell_shear,
+                bends: &s.node_bend,
+                ties: &s.ties,
+                planes: &s.planes,
+            };
+            let (violation, worst) = self.projection.measure(&problem, &s.vel);
+            if violation <= tol || !last.converged || pass >= params.collision_passes + EXTRA_PASSES
+            {
+                break (violation, worst);
+            }
         };
-        let (violation, worst) = self.projection.measure(&problem, &s.vel);
+        report.collision_passes = pass;
         report.violation = violation;
         report.worst = worst;
         report.shape_converged = violation <= tol;
