@@ -23,6 +23,7 @@ fn main() {
     let mut sim = Simulation::new(scene).expect("sim");
     let (mut steps, mut bad, mut worst) = (0, 0, 0.0f64);
     let (mut inside, mut depth, mut iterations, mut halved) = (0usize, 0.0f64, 0usize, 0usize);
+    let mut extra = 0usize;
     let wall = std::time::Instant::now();
     println!("inside at the start: {}", sim.inside_by_part());
     while sim.time() < until - 1e-9 {
@@ -33,6 +34,9 @@ fn main() {
                 depth = depth.max(o.depth);
                 iterations += o.report.shape_iterations;
                 halved += usize::from(o.substeps > 1);
+                extra += usize::from(
+                    o.report.collision_passes > sim.scene().settings.step.collision_passes,
+                );
                 if !o.report.converged {
                     bad += 1;
                     worst = worst.max(o.report.violation);
@@ -124,7 +128,7 @@ fn main() {
     }
     let (sewn, all) = sim.sewing_progress();
     println!(
-        "{steps} steps, {bad} unconverged (worst {worst:.2e}), {:.1} s wall, sewn at {:?}; {:.1} shape iterations per step; most nodes inside the body {inside} (deepest {:.1} mm); {halved} steps taken again in parts",
+        "{steps} steps, {bad} unconverged (worst {worst:.2e}), {:.1} s wall, sewn at {:?}; {:.1} shape iterations per step; most nodes inside the body {inside} (deepest {:.1} mm); {halved} steps taken again in parts, {extra} with extra collision passes",
         wall.elapsed().as_secs_f64(),
         sim.sewn_at(),
         iterations as f64 / steps.max(1) as f64,
