@@ -1,6 +1,8 @@
 //! Long runs (issue 10): the walking dress for 60 s does not drift — no growth of the cloth's
 //! motion relative to the body, no creeping down the body, no penetration beyond the 6 s
-//! scenario's bound. About 1.5–3 minutes in release mode.
+//! scenario's bound. 1.5–3 minutes on the unconverged step; on the converged step (6 000
+//! steps solved to the tolerance) more than 16 minutes, over CI's budget: ignored, run by hand
+//! with `cargo test --release -p atelier --test long_run -- --ignored` (docs/performance.md).
 
 use std::path::PathBuf;
 
@@ -29,6 +31,7 @@ fn centroid(points: &[[f64; 3]]) -> [f64; 3] {
 /// growth), their height within 5 mm of those cycles' (no creeping), every seam still closed,
 /// and the largest penetration over the whole run within the 6 s scenario's 2 mm.
 #[test]
+#[ignore = "over CI's budget on the converged step (6 000 steps; unfinished after 16 min, session 8): run with -- --ignored, docs/performance.md"]
 fn a_sixty_second_walk_does_not_drift() {
     let text = std::fs::read_to_string(root().join("fixtures/scenarios/dress_walk.ron"))
         .expect("scenario")
