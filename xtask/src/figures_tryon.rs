@@ -1,6 +1,6 @@
 //! The try-on's figures and table (issue 11; `docs/tryon.md`): each synthetic photograph of
-//! `atelier::tryon::examples` tried on with the sewn dress — photograph, fitted silhouette over
-//! the mask, composite, side by side (`tryon_<name>.png`) — and `tryon.md` with the overlap
+//! `atelier::tryon::examples` tried on with the sewn skirt (the sleeved dress's cost:
+//! `docs/performance.md`) — photograph, fitted silhouette over the mask, composite, side by side (`tryon_<name>.png`) — and `tryon.md` with the overlap
 //! before and after the fit, the worst joint-angle error, the size and the times. Then the
 //! same photographs taken exactly from the front, fitted only, to measure what a frontal
 //! silhouette leaves open, and one photograph segmented instead of masked.
@@ -71,19 +71,19 @@ fn fit_only(e: &Example, yaw_deg: f64) -> Result<(PoseFit, Camera)> {
 }
 
 pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
-    let garment = root.join("fixtures/scenarios/dress_sewn.ron");
+    let garment = root.join("fixtures/scenarios/skirt_sewn.ron");
     let mut written = Vec::new();
     let mut md = String::new();
     writeln!(md, "# Try-on on synthetic photographs\n")?;
     writeln!(
         md,
-        "The 9AR mannequin at bust 88 cm (two sizes up), posed, photographed by an orthographic camera 240 px/m, {} × {} px; fitted from the standard pose with the camera from the mask's box; then the sewn dress (`dress_sewn.ron`) dressed on the fitted body and moved to the fitted pose. Angle error: the largest over the 12 fitted angles.\n",
+        "The 9AR mannequin at bust 88 cm (two sizes up), posed, photographed by an orthographic camera 240 px/m, {} × {} px; fitted from the standard pose with the camera from the mask's box; then the sewn skirt (`skirt_sewn.ron`) dressed on the fitted body and moved to the fitted pose. Angle error: the largest over the 12 fitted angles.\n",
         examples()[0].size.0,
         examples()[0].size.1
     )?;
     writeln!(
         md,
-        "| photograph | view | IoU before | IoU after | worst angle error | bust (truth 88 cm) | fit | evaluations | dress and motion | whole try-on |"
+        "| photograph | view | IoU before | IoU after | worst angle error | bust (truth 88 cm) | fit | evaluations | garment and motion | whole try-on |"
     )?;
     writeln!(md, "|---|---|---|---|---|---|---|---|---|---|")?;
     for e in examples() {

@@ -602,7 +602,7 @@ fn tryon_runs_the_fixture_and_refuses_a_mask_of_another_picture() {
         "--mask",
         "fixtures/tryon/arms_raised_mask.png",
         "--garment",
-        "fixtures/scenarios/dress_sewn.ron",
+        "fixtures/scenarios/skirt_sewn.ron",
         "--yaw",
         "30",
         "--light",
@@ -636,7 +636,7 @@ fn tryon_runs_the_fixture_and_refuses_a_mask_of_another_picture() {
         "--mask",
         "fixtures/tryon/mid_stride.png",
         "--garment",
-        "fixtures/scenarios/dress_sewn.ron",
+        "fixtures/scenarios/skirt_sewn.ron",
         "--out",
         &out_s,
     ]);

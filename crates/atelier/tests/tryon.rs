@@ -126,7 +126,7 @@ fn the_composite_keeps_the_photograph_outside_the_garment() {
     let mut inputs = TryonInputs::new(
         dir.join("photo.png"),
         Some(dir.join("mask.png")),
-        root().join("fixtures/scenarios/dress_sewn.ron"),
+        root().join("fixtures/scenarios/skirt_sewn.ron"),
     );
     inputs.yaw_deg = e.camera.yaw_deg;
     let out = dir.join("out");
@@ -172,7 +172,7 @@ fn the_composite_keeps_the_photograph_outside_the_garment() {
         }
     }
     assert_eq!(inside, info.garment_pixels);
-    // The dress covers a good part of the person, and it shows.
+    // The skirt covers a good part of the person, and it shows.
     assert!(
         inside * 5 > mask.count(),
         "{inside} garment pixels of {}",
