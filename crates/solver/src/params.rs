@@ -158,7 +158,8 @@ pub struct StepParams {
     /// a singular start and needs more).
     pub shape_max_iterations: usize,
     /// Collision passes per step; the shape stage runs before each (the thesis: two passes).
-    /// Range ≥ 1; default 2.
+    /// Range ≥ 1; default 2. Up to 4 more are made while the last pass's solve converged and
+    /// its collision pass left the shape above the tolerance.
     pub collision_passes: usize,
     /// Axial edges: equality or stretch-only. Default `Equality` (see `docs/solver.md`).
     pub axial_constraint: ConstraintKind,
