@@ -36,6 +36,6 @@ pub use params::{
 pub use shear_angle::ShearMeasure;
 pub use state::ClothState;
 pub use step::{
-    CollisionHook, HookContext, NoCollision, SolveStats, Solver, Stage, StageTimings, StepError,
-    StepReport, Tie,
+    CollisionHook, EXTRA_PASSES, HookContext, NoCollision, SolveStats, Solver, Stage, StageTimings,
+    StepError, StepReport, Tie,
 };

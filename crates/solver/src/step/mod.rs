@@ -47,6 +47,7 @@ pub(crate) use hook::plane_push;
 pub use hook::{CollisionHook, HookContext, NoCollision, Tie};
 pub use projection::Constraint;
 pub use report::{SolveStats, Stage, StageTimings, StepError, StepReport};
+pub use shape::EXTRA_PASSES;
 
 use par::PAR_MIN;
 use report::{guard_edges, guard_nodes};

@@ -136,8 +136,9 @@ pub struct StepReport {
     pub worst: Option<Constraint>,
     /// The violation at the end of the last pass's iterations (before its collision pass).
     pub shape_pass_violation: f64,
-    /// Collision passes made: `StepParams::collision_passes`, or up to `EXTRA_PASSES` (4) more
-    /// when the last one left the shape above its tolerance.
+    /// Collision passes made: `StepParams::collision_passes`, or up to
+    /// [`EXTRA_PASSES`](crate::EXTRA_PASSES) more when the last one left a converged shape
+    /// above its tolerance.
     pub collision_passes: usize,
     /// Shape iterations over all passes.
     pub shape_iterations: usize,

@@ -267,3 +267,72 @@ fn skirt_measurements() {
         }
     }
 }
+
+/// A hook that moves one node 1 mm along the sheet (a contact's push) in the passes `nudge`
+/// selects: first-order changes of its edges' lengths (1e-2 of the 10 cm spacing), far above
+/// the tolerance.
+struct Nudge {
+    node: usize,
+    nudge: fn(usize) -> bool,
+}
+
+impl atelier_solver::CollisionHook for Nudge {
+    fn resolve(&mut self, ctx: atelier_solver::HookContext<'_>) {
+        if (self.nudge)(ctx.pass) {
+            ctx.velocities[self.node].x += 1e-3 / ctx.dt;
+        }
+    }
+}
+
+/// One step of an 11 × 11 sheet (1 m, hung by its top row) with `hook`.
+fn nudged_step(nudge: fn(usize) -> bool) -> atelier_solver::StepReport {
+    use atelier_fabric::AnisotropyForm;
+    use atelier_grid::{ClothTopology, StructuredGrid};
+    use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+    let f = fabric("cotton_broad");
+    let n = 11;
+    let topo =
+        ClothTopology::from_structured(&StructuredGrid::sheet(n, n, 1.0, 1.0)).expect("grid");
+    let mut cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
+    let place = |[x, y]: [f64; 2]| nalgebra::Vector3::new(x, 0.0, y);
+    for i in 0..n {
+        let node = (n - 1) * n + i;
+        let p = place(cloth.topology().rest_positions()[node]);
+        cloth.pin(node as u32, p, PinMotion::Fixed).expect("pin");
+    }
+    let mut state = ClothState::placed(&cloth, place);
+    let params = StepParams::default();
+    let mut hook = Nudge {
+        node: 5 * n + 5,
+        nudge,
+    };
+    Solver::new()
+        .step_with(&cloth, &mut state, &params, &mut hook)
+        .expect("step")
+}
+
+/// Extra collision passes (`docs/solver.md`, "Extra collision passes, session 9"): a push in the
+/// last regular pass after a converged solve gets one more pass, and the step ends within the
+/// tolerance; a push in every pass ends after the extra passes, reported as not converged; no
+/// push, the thesis's two passes.
+#[test]
+fn a_push_in_the_last_collision_pass_gets_another_pass() {
+    let tol = atelier_solver::StepParams::default().shape_tolerance;
+    let passes = atelier_solver::StepParams::default().collision_passes;
+    let quiet = nudged_step(|_| false);
+    assert_eq!(quiet.collision_passes, passes, "{quiet:?}");
+    assert!(quiet.shape_converged, "{quiet:?}");
+    let once = nudged_step(|pass| pass == 1);
+    assert_eq!(once.collision_passes, passes + 1, "{once:?}");
+    assert!(once.shape_converged && once.violation <= tol, "{once:?}");
+    let always = nudged_step(|_| true);
+    assert_eq!(
+        always.collision_passes,
+        passes + atelier_solver::EXTRA_PASSES,
+        "{always:?}"
+    );
+    assert!(
+        !always.shape_converged && always.violation > tol,
+        "{always:?}"
+    );
+}
