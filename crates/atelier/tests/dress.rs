@@ -148,10 +148,11 @@ fn the_dress_walks_without_entering_the_body() {
 /// Ignored since the converged step landed (session 8): a regression, not a pass. The
 /// inextensible dress is caught at the abdomen — from 1.5 s on the same ~130 nodes stay inside
 /// (abdomen, 79.5 mm deep) until the 2 s push limit, the cloth around them at 3.9–4.3 % strain
-/// under the push. The unconverged step let the cloth stretch past the body. Measured and open in
-/// docs/validation.md ("Not solved this session: the one-sided dressing").
+/// under the push. The unconverged step let the cloth stretch past the body. Session 9 (extra
+/// collision passes, every step converged): 198 nodes inside at 2 s (chest 160, abdomen 38).
+/// Measured and open in docs/validation.md ("Every scenario on the converged step").
 #[test]
-#[ignore = "regression on the converged step: the dress stays caught at the abdomen (130 nodes inside after the 2 s push); docs/validation.md"]
+#[ignore = "regression on the converged step: the dress stays caught in the body (session 9: 198 nodes inside after the 2 s push, chest and abdomen); docs/validation.md"]
 fn the_dress_is_dressed_through_the_body_by_one_sided_contact() {
     let spec = spec("dress_one_sided", 0.2, 0.5);
     let run = run_garment(&spec, &scenarios(), &mut |_| {}).expect("runs");
