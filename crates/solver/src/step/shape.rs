@@ -50,24 +50,31 @@ impl Solver {
         // met the tolerance and its collision pass left the shape above it (a contact found or
         // a seam drawn in that pass), each ending with its collision pass. A shape solve that
         // did not converge is not given more passes: the caller halves the step instead.
+        // The problem over the scratch's fields (a macro: the solve borrows other fields of the
+        // same scratch mutably beside it).
+        macro_rules! problem {
+            ($s:expr) => {
+                ShapeProblem {
+                    cloth,
+                    positions: &state.positions,
+                    dt,
+                    time,
+                    damping: params.damping,
+                    targets: &$s.target,
+                    tension,
+                    axial: params.axial_constraint,
+                    measure: params.shear_measure,
+                    shear: &$s.cell_shear,
+                    bends: &$s.node_bend,
+                    ties: &$s.ties,
+                    planes: &$s.planes,
+                }
+            };
+        }
         let mut pass = 0;
         let (violation, worst) = loop {
             let s = &mut self.s;
-            let problem = ShapeProblem {
-                cloth,
-                positions: &state.positions,
-                dt,
-                time,
-                damping: params.damping,
-                targets: &s.target,
-                tension,
-                axial: params.axial_constraint,
-                measure: params.shear_measure,
-                shear: &s.cell_shear,
-                bends: &s.node_bend,
-                ties: &s.ties,
-                planes: &s.planes,
-            };
+            let problem = problem!(s);
             let (air, long_range) = (&mut self.pressure, &mut s.long_range);
             let (lr_on, slack) = (s.long_range_on, s.long_range_slack);
             let mut after = |vel: &mut [super::V3]| {
@@ -110,21 +117,7 @@ impl Solver {
             }
             // What the step ends with, after the last collision pass.
             let s = &mut self.s;
-            let problem = ShapeProblem {
-                cloth,
-                positions: &state.positions,
-                dt,
-                time,
-                damping: params.damping,
-                targets: &s.target,
-                tension,
-                axial: params.axial_constraint,
-                measure: params.shear_measure,
-                shear: &s.cell_shear,
-                bends: &s.node_bend,
-                ties: &s.ties,
-                planes: &s.planes,
-            };
+            let problem = problem!(s);
             let (violation, worst) = self.projection.measure(&problem, &s.vel);
             if violation <= tol || !last.converged || pass >= params.collision_passes + EXTRA_PASSES
             {
