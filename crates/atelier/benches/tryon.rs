@@ -20,9 +20,8 @@ use atelier::scenario::{Scenario, ScenarioKind};
 use atelier::tryon::camera::coverage;
 use atelier::tryon::composite::composite;
 use atelier::tryon::examples::examples;
-use atelier::tryon::motion_to;
 use atelier::tryon::pose::{FitOptions, PoseFile, fit_pose, posed_mannequin, synthetic_photo};
-use atelier::{Garment, Scene};
+use atelier::tryon::posed_scene;
 use atelier_body::Mannequin;
 use atelier_body::build::jis_9ar_description;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -61,17 +60,7 @@ fn tryon(c: &mut Criterion) {
         panic!("a garment scenario")
     };
     let mannequin = Mannequin::from_description(&d, &e.sizes).expect("mannequin");
-    let (motion, duration) = motion_to(&e.angles, &mannequin).expect("motion");
-    let garment = Garment::load(
-        &scenarios.join(&spec.garment),
-        &scenarios.join(&spec.fabric),
-        spec.placements.clone(),
-        spec.place,
-    )
-    .expect("garment");
-    let mut settings = spec.settings.clone();
-    settings.motion_time = duration + atelier::tryon::HOLD_S;
-    let scene = Scene::new(garment, mannequin, Some(motion), settings).expect("scene");
+    let scene = posed_scene(spec, &scenarios, mannequin, &e.angles).expect("scene");
     let sim = simulate_scene(scene, &mut |_| {}).expect("simulated");
     let cloth = sim.cloth.frames.last().expect("frame").clone();
     let solid = sim.solid.as_ref().expect("body");

@@ -5,8 +5,7 @@
 //! (`PROBE_9AR=1`: the 9AR mannequin's sizes instead of the example person's).
 use atelier::Simulation;
 use atelier::scenario::{Scenario, ScenarioKind};
-use atelier::scene::{Garment, Scene};
-use atelier::tryon::{HOLD_S, examples::examples, motion_to};
+use atelier::tryon::{HOLD_S, examples::examples, posed_scene};
 use atelier_body::Mannequin;
 use atelier_body::build::{Sizes, jis_9ar_description};
 use std::path::Path;
@@ -34,19 +33,12 @@ fn main() {
         e.sizes
     };
     let mannequin = Mannequin::from_description(&jis_9ar_description(), &sizes).expect("body");
-    let (motion, motion_s) = motion_to(&e.angles, &mannequin).expect("motion");
-    let g = Garment::load(
-        &base.join(&spec.garment),
-        &base.join(&spec.fabric),
-        spec.placements.clone(),
-        spec.place,
-    )
-    .expect("garment");
-    let mut settings = spec.settings.clone();
-    settings.motion_time = motion_s + HOLD_S;
-    let scene = Scene::new(g, mannequin, Some(motion), settings).expect("scene");
+    let scene = posed_scene(spec, base, mannequin, &e.angles).expect("scene");
+    println!(
+        "motion to the pose + hold {HOLD_S} s, {:.2} s in all",
+        scene.settings.motion_time
+    );
     let mut sim = Simulation::new(scene).expect("sim");
-    println!("motion {motion_s:.2} s + hold {HOLD_S} s");
     let wall = std::time::Instant::now();
     let (mut steps, mut bad, mut its, mut facts) = (0usize, 0usize, 0usize, 0usize);
     while sim.time() < until - 1e-9 {

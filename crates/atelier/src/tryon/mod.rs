@@ -25,7 +25,7 @@ use crate::run::{
     RunError, RunOptions, base_of, outputs, prepare_folder, simulate_scene, write_run,
 };
 use crate::scenario::{Scenario, ScenarioKind};
-use crate::scene::{Garment, Scene};
+use crate::scene::{Garment, GarmentSpec, Scene};
 use camera::Camera;
 use image::{Mask, Photo};
 use pose::{FitOptions, PoseFile, PoseFit};
@@ -186,6 +186,29 @@ pub fn motion_to(
     Ok((motion, duration))
 }
 
+/// The try-on's garment scene: `spec`'s garment and fabric (paths relative to `base`) sewn on
+/// `mannequin` in the standard pose, then moved to the joint `angles` ([`motion_to`]) and held
+/// there for [`HOLD_S`].
+pub fn posed_scene(
+    spec: &GarmentSpec,
+    base: &Path,
+    mannequin: Mannequin,
+    angles: &[[f64; 3]; 17],
+) -> Result<Scene, TryonError> {
+    let (motion, motion_s) = motion_to(angles, &mannequin)?;
+    let garment = Garment::load(
+        &base.join(&spec.garment),
+        &base.join(&spec.fabric),
+        spec.placements.clone(),
+        spec.place,
+    )
+    .map_err(|e| RunError::Setup(e.to_string()))?;
+    let mut settings = spec.settings.clone();
+    settings.motion_time = motion_s + HOLD_S;
+    Ok(Scene::new(garment, mannequin, Some(motion), settings)
+        .map_err(|e| RunError::Setup(e.to_string()))?)
+}
+
 /// Run a try-on into `out`: fit, dress, move, composite; writes `composite.png`,
 /// `overlay.png`, `footprint.png`, `fitted_pose.ron` and the garment run's usual outputs and `report.json` (with
 /// a `tryon` section). A fit below [`LOW_IOU`] is reported in the warnings, not hidden.
@@ -234,18 +257,8 @@ pub fn tryon(
     // The garment on the fitted mannequin, moved from the standard pose to the fitted one.
     let mannequin = Mannequin::from_description(&description, &fit.sizes)
         .map_err(|e| TryonError::Input(format!("the fitted body: {e}")))?;
-    let (motion, motion_s) = motion_to(&fit.angles, &mannequin)?;
-    let garment = Garment::load(
-        &base.join(&spec.garment),
-        &base.join(&spec.fabric),
-        spec.placements.clone(),
-        spec.place,
-    )
-    .map_err(|e| RunError::Setup(e.to_string()))?;
-    let mut settings = spec.settings.clone();
-    settings.motion_time = motion_s + HOLD_S;
-    let scene = Scene::new(garment, mannequin, Some(motion), settings)
-        .map_err(|e| RunError::Setup(e.to_string()))?;
+    let scene = posed_scene(spec, &base, mannequin, &fit.angles)?;
+    let motion_s = scene.settings.motion_time - HOLD_S;
     prepare_folder(out)?;
     let mut sim_progress = |f: f64| progress(0.1 + 0.9 * f);
     let sim = simulate_scene(scene, &mut sim_progress)?;
