@@ -160,15 +160,12 @@ fn virtual_kes_shear_test_is_quasi_static() {
 /// the KES strain rate, the moving clamp's reaction against its displacement gives back the
 /// fabric's EMT, LT, WT and RT within 2 %.
 ///
-/// Fails on the current step: the shape stage's Newton iteration starts every step from zero
-/// multipliers, so it peeks every edge's strain at zero force; once an edge's force exceeds the
-/// tensile dead band (1e-3 F_m) that peek is a reversal onto the stiff minor unloading branch,
-/// the iteration ends with the edges in compression (rigid), and the clamp reads −47 N/m at
-/// 0.2 % strain where the fabric has +4.4 (`docs/validation.md`, "Virtual KES instruments").
-/// Warm-starting the edges' multipliers from the last step's tensions makes it pass (EMT, LT,
-/// WT, RT within 0.2 %; on its own it moves the cotton bending test by 4 %).
+/// Failed until session 10: the shape stage's Newton iteration started every step from zero
+/// multipliers, so it read every loaded edge at zero force, a reversal onto the stiff minor
+/// unloading branch, and ended with the edges in compression (the clamp read −47 N/m at 0.2 %
+/// strain where the fabric has +4.4). The rows of loaded edges now start at their committed
+/// force (`ShapeSolver::warm_start_loaded_edges`).
 #[test]
-#[ignore = "blocked by the shape stage's cold start at the tensile toe (docs/validation.md, issue 21)"]
 fn virtual_kes_tensile_test_recovers_emt_lt_wt_rt() {
     for (name, direction) in [
         ("cotton_broad", Direction::Warp),
