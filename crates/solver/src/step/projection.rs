@@ -229,6 +229,9 @@ pub struct ShapeReport {
     pub line_search: bool,
     /// The constraint with the largest violation (None when nothing is violated).
     pub worst: Option<Constraint>,
+    /// Whether the solve was made again with the loaded edges warm-started after the first
+    /// ended above the tolerance ([`ShapeSolver::solve`]).
+    pub retried: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -324,6 +327,8 @@ pub struct ShapeSolver {
     full_newton: bool,
     /// |λ|/l of each edge and tie row in tension (the geometric stiffness), else 0.
     tension_over_length: Vec<f64>,
+    /// The velocities a first pass started from (for its warm-started second solve).
+    start_vel: Vec<V3>,
 }
 
 fn find(root: &mut [u32], mut i: u32) -> u32 {
@@ -1232,6 +1237,11 @@ impl ShapeSolver {
     /// constraints are projected again (the pressure stage's volume constraint, the long-range
     /// attachments). The rows are (re)built and the multipliers reset when `first_pass` (once
     /// per step). `step` is the Jacobi and Chebyshev γ.
+    ///
+    /// A first pass of a global method that ends above the tolerance is solved once more from
+    /// the same start with the rows of loaded edges warm-started
+    /// ([`ShapeSolver::warm_start_loaded_edges`]), when there are such rows and the rows did not
+    /// change this step; the report then counts both solves' work.
     #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &mut self,
@@ -1244,22 +1254,72 @@ impl ShapeSolver {
         first_pass: bool,
         after: &mut dyn FnMut(&mut [V3]),
     ) -> Result<ShapeReport, DualError> {
+        let global = matches!(
+            method,
+            ShapeMethod::Newton
+                | ShapeMethod::Direct { .. }
+                | ShapeMethod::ConjugateGradient { .. }
+        );
+        let retry = first_pass && global;
+        if retry {
+            self.start_vel.clear();
+            self.start_vel.extend_from_slice(vel);
+        }
+        let analyses = self.analyses;
+        let cold = self.solve_from(
+            p,
+            vel,
+            method,
+            step,
+            tol,
+            max_iterations,
+            first_pass,
+            false,
+            after,
+        )?;
+        // Not when the rows changed this step (seams closed: the ties' pull is gone, and the
+        // last step's forces are the balance of another system).
+        if cold.converged || !retry || self.analyses != analyses || !self.has_loaded_edges(p) {
+            return Ok(cold);
+        }
+        vel.copy_from_slice(&self.start_vel);
+        let mut warm = self.solve_from(
+            p,
+            vel,
+            method,
+            step,
+            tol,
+            max_iterations,
+            first_pass,
+            true,
+            after,
+        )?;
+        warm.iterations += cold.iterations;
+        warm.factorizations += cold.factorizations;
+        warm.linear_iterations += cold.linear_iterations;
+        warm.backtracks += cold.backtracks;
+        warm.retried = true;
+        Ok(warm)
+    }
+
+    /// One solve of [`ShapeSolver::solve`], its loaded edges warm-started when `warm_start`.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_from(
+        &mut self,
+        p: &ShapeProblem<'_>,
+        vel: &mut [V3],
+        method: ShapeMethod,
+        step: f64,
+        tol: f64,
+        max_iterations: usize,
+        first_pass: bool,
+        warm_start: bool,
+        after: &mut dyn FnMut(&mut [V3]),
+    ) -> Result<ShapeReport, DualError> {
         let mut warm = false;
         if first_pass || self.structure.is_none() {
-            let analyses = self.analyses;
             self.prepare(p)?;
-            // Not when the rows changed this step (seams closed: the ties' pull is gone, and the
-            // last step's forces are the balance of another system; warm-started there, the
-            // dress's sewing step was taken again in halves and the default scene's ended
-            // 2.2e-2 above the tolerance).
-            if self.analyses == analyses
-                && matches!(
-                    method,
-                    ShapeMethod::Newton
-                        | ShapeMethod::Direct { .. }
-                        | ShapeMethod::ConjugateGradient { .. }
-                )
-            {
+            if warm_start {
                 warm = self.warm_start_loaded_edges(p);
             }
         }
@@ -1475,26 +1535,40 @@ impl ShapeSolver {
     /// the balance with the multipliers (the local methods would need the positions moved too).
     /// Returns whether any row was started.
     fn warm_start_loaded_edges(&mut self, p: &ShapeProblem<'_>) -> bool {
-        let Some(t) = p.tension.filter(|t| t.hysteresis) else {
-            return false;
-        };
-        let mut any = false;
-        let st = self.structure.as_ref().expect("prepared");
         let dt2 = p.dt * p.dt;
-        for (r, kind) in st.kinds.iter().enumerate() {
-            let RowKind::Edge(e) = *kind else { continue };
-            if st.dead[r] || st.twin_of[r] != NONE || st.gathered[r] {
-                continue;
-            }
-            let e = e as usize;
-            let state = &t.states[e];
-            let band = t.table.tensile(t.materials[e]).deadband();
-            if state.branch() == Branch::Loading && state.force() > band {
-                self.lambda[r] = -state.force() * t.widths[e] * st.width_scale[r] * dt2;
-                any = true;
-            }
+        let loaded: Vec<(usize, f64)> = self.loaded_edges(p).collect();
+        for &(r, f) in &loaded {
+            self.lambda[r] = -f * dt2;
         }
-        any
+        !loaded.is_empty()
+    }
+
+    /// Whether any row would be warm-started ([`ShapeSolver::warm_start_loaded_edges`]).
+    fn has_loaded_edges(&self, p: &ShapeProblem<'_>) -> bool {
+        self.loaded_edges(p).next().is_some()
+    }
+
+    /// The rows of edges on a loading branch above their tensile dead band, with the force
+    /// (N) their hysteresis state committed, over the row's width.
+    fn loaded_edges<'s>(
+        &'s self,
+        p: &'s ShapeProblem<'_>,
+    ) -> impl Iterator<Item = (usize, f64)> + 's {
+        let t = p.tension.filter(|t| t.hysteresis);
+        let st = self.structure.as_ref();
+        st.zip(t).into_iter().flat_map(move |(st, t)| {
+            st.kinds.iter().enumerate().filter_map(move |(r, kind)| {
+                let RowKind::Edge(e) = *kind else { return None };
+                if st.dead[r] || st.twin_of[r] != NONE || st.gathered[r] {
+                    return None;
+                }
+                let e = e as usize;
+                let state = &t.states[e];
+                let band = t.table.tensile(t.materials[e]).deadband();
+                (state.branch() == Branch::Loading && state.force() > band)
+                    .then(|| (r, state.force() * t.widths[e] * st.width_scale[r]))
+            })
+        })
     }
 
     /// Whether `vel` is the balance with the current multipliers: every node within `tol` of

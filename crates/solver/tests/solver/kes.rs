@@ -163,8 +163,8 @@ fn virtual_kes_shear_test_is_quasi_static() {
 /// Failed until session 10: the shape stage's Newton iteration started every step from zero
 /// multipliers, so it read every loaded edge at zero force, a reversal onto the stiff minor
 /// unloading branch, and ended with the edges in compression (the clamp read −47 N/m at 0.2 %
-/// strain where the fabric has +4.4). The rows of loaded edges now start at their committed
-/// force (`ShapeSolver::warm_start_loaded_edges`).
+/// strain where the fabric has +4.4). A first pass that ends above the tolerance is now solved
+/// again with the rows of loaded edges started at their committed force (`ShapeSolver::solve`).
 #[test]
 fn virtual_kes_tensile_test_recovers_emt_lt_wt_rt() {
     for (name, direction) in [
