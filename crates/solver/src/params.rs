@@ -55,6 +55,15 @@ pub enum ShapeMethod {
 impl ShapeMethod {
     /// The default: [`ShapeMethod::Newton`].
     pub const DEFAULT: Self = Self::Newton;
+
+    /// Whether the method solves the whole system at once (Newton, Direct, CG) rather than row
+    /// by row (Jacobi, Chebyshev, Gauss–Seidel).
+    pub fn is_global(self) -> bool {
+        matches!(
+            self,
+            Self::Newton | Self::Direct { .. } | Self::ConjugateGradient { .. }
+        )
+    }
 }
 
 /// Whether the axial edges resist compression.

@@ -1254,46 +1254,33 @@ impl ShapeSolver {
         first_pass: bool,
         after: &mut dyn FnMut(&mut [V3]),
     ) -> Result<ShapeReport, DualError> {
-        let global = matches!(
-            method,
-            ShapeMethod::Newton
-                | ShapeMethod::Direct { .. }
-                | ShapeMethod::ConjugateGradient { .. }
-        );
-        let retry = first_pass && global;
+        let retry = first_pass && method.is_global();
         if retry {
             self.start_vel.clear();
             self.start_vel.extend_from_slice(vel);
         }
         let analyses = self.analyses;
-        let cold = self.solve_from(
-            p,
-            vel,
-            method,
-            step,
-            tol,
-            max_iterations,
-            first_pass,
-            false,
-            after,
-        )?;
+        let mut run = |this: &mut Self, vel: &mut [V3], warm: bool| {
+            this.solve_from(
+                p,
+                vel,
+                method,
+                step,
+                tol,
+                max_iterations,
+                first_pass,
+                warm,
+                after,
+            )
+        };
+        let cold = run(self, vel, false)?;
         // Not when the rows changed this step (seams closed: the ties' pull is gone, and the
         // last step's forces are the balance of another system).
         if cold.converged || !retry || self.analyses != analyses || !self.has_loaded_edges(p) {
             return Ok(cold);
         }
         vel.copy_from_slice(&self.start_vel);
-        let mut warm = self.solve_from(
-            p,
-            vel,
-            method,
-            step,
-            tol,
-            max_iterations,
-            first_pass,
-            true,
-            after,
-        )?;
+        let mut warm = run(self, vel, true)?;
         warm.iterations += cold.iterations;
         warm.factorizations += cold.factorizations;
         warm.linear_iterations += cold.linear_iterations;
@@ -1351,12 +1338,7 @@ impl ShapeSolver {
             }
             let k = report.iterations;
             report.iterations += 1;
-            if matches!(
-                method,
-                ShapeMethod::Newton
-                    | ShapeMethod::Direct { .. }
-                    | ShapeMethod::ConjugateGradient { .. }
-            ) {
+            if method.is_global() {
                 self.update_contacts(p, vel);
                 self.shift_towards_balance(p, vel, method != ShapeMethod::Newton);
             }

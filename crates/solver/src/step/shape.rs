@@ -8,7 +8,7 @@ use super::projection::{EdgeTension, ShapeProblem, ShapeReport};
 use super::report::{Stage, StepError, StepReport, guard_nodes};
 use super::{CollisionHook, Solver};
 use crate::cloth::Cloth;
-use crate::params::{ShapeMethod, StepParams, Tension};
+use crate::params::{StepParams, Tension};
 use crate::state::ClothState;
 
 /// Collision passes a step may add to `StepParams::collision_passes` when the last one leaves
@@ -31,10 +31,7 @@ impl Solver {
     ) -> Result<(), StepError> {
         let (dt, time) = (params.dt, state.time);
         let tol = params.shape_tolerance * factor;
-        let local = matches!(
-            params.shape_method,
-            ShapeMethod::Jacobi | ShapeMethod::Chebyshev { .. } | ShapeMethod::GaussSeidel { .. }
-        );
+        let local = !params.shape_method.is_global();
         self.prepare_long_range(cloth, params, local);
         let mut collision = Duration::ZERO;
         let mut pressure = Duration::ZERO;
