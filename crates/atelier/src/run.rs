@@ -616,6 +616,11 @@ fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
     put("max_motion_kinetic_energy_j", Some(run.max_motion_energy));
     put("lowest_node_m", lowest);
     put("nodes_below_body", Some(below as f64));
+    let hem = run.frames.last().and_then(|f| {
+        atelier_solver::metrics::hem_extent(&f.cloth, atelier_solver::metrics::HEM_BAND)
+    });
+    put("hem_width_m", hem.map(|h| h.width));
+    put("hem_depth_m", hem.map(|h| h.depth));
     Simulated {
         fabric: String::new(),
         cloth_triangles: run.cloth_triangles,

@@ -120,6 +120,8 @@ impl ScenarioKind {
                 "max_motion_kinetic_energy_j",
                 "lowest_node_m",
                 "nodes_below_body",
+                "hem_width_m",
+                "hem_depth_m",
                 "frames",
                 crate::convergence::UNCONVERGED_FRACTION,
             ],

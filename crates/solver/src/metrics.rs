@@ -316,11 +316,78 @@ pub fn axial_strains<'a>(
         })
 }
 
+/// How far above a garment's lowest node its hem band reaches, m: the hem measure
+/// ([`hem_extent`]) takes every node within this height of the lowest (the lowest row of a 2 cm
+/// grid and the hem's rise over its folds; the extents of the dresses' hems did not change
+/// between 3, 5 and 10 cm).
+pub const HEM_BAND: f64 = 0.03;
+
+/// The silhouette of a hanging garment's hem, in the body's frame (x the body's left, y up,
+/// z forward): the extent of the nodes within `band` of the lowest node along x (its width in
+/// the front view) and along z (its depth in the side view). `None` without nodes or with a
+/// non-finite position.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HemExtent {
+    /// Width in the front view, m (largest minus smallest x).
+    pub width: f64,
+    /// Depth in the side view, m (largest minus smallest z).
+    pub depth: f64,
+}
+
+/// The [`HemExtent`] of the nodes at `positions` within `band` (m) of the lowest.
+pub fn hem_extent(positions: &[[f64; 3]], band: f64) -> Option<HemExtent> {
+    if positions.iter().flatten().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let lowest = positions.iter().map(|p| p[1]).reduce(f64::min)?;
+    let hem = positions.iter().filter(|p| p[1] <= lowest + band);
+    let (mut x, mut z) = (
+        [f64::INFINITY, f64::NEG_INFINITY],
+        [f64::INFINITY, f64::NEG_INFINITY],
+    );
+    for p in hem {
+        x = [x[0].min(p[0]), x[1].max(p[0])];
+        z = [z[0].min(p[2]), z[1].max(p[2])];
+    }
+    Some(HemExtent {
+        width: x[1] - x[0],
+        depth: z[1] - z[0],
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use std::f64::consts::{PI, TAU};
 
     use super::*;
+
+    /// An elliptic skirt: a cone of rings from a waist (radius 0.15 × 0.10 m at y = 1) down to
+    /// a hem of semi-axes 0.25 × 0.12 m at y = 0.4, whose hem ring is slightly wavy in height
+    /// (±5 mm): the hem's extents are the ellipse's axes; the rings 2 and 4 cm above it, inside
+    /// the 3 and 5 cm bands, are narrower and do not change them; the rings above do not count.
+    #[test]
+    fn hem_extent_reads_the_axes_of_an_elliptic_hem() {
+        let mut pos = Vec::new();
+        for ring in 0..=30 {
+            let t = ring as f64 / 30.0;
+            let (a, b, y) = (0.15 + 0.10 * t, 0.10 + 0.02 * t, 1.0 - 0.6 * t);
+            for k in 0..72 {
+                let psi = TAU * k as f64 / 72.0;
+                let wave = if ring == 30 {
+                    0.005 * (7.0 * psi).sin()
+                } else {
+                    0.0
+                };
+                pos.push([a * psi.cos(), y + wave, b * psi.sin()]);
+            }
+        }
+        let e = hem_extent(&pos, HEM_BAND).expect("measured");
+        assert!((e.width - 0.50).abs() < 1e-12, "width {}", e.width);
+        assert!((e.depth - 2.0 * 0.12 * (TAU * 18.0 / 72.0).sin()).abs() < 1e-12);
+        assert!((hem_extent(&pos, 0.05).expect("measured").width - 0.50).abs() < 1e-12);
+        assert_eq!(hem_extent(&[], HEM_BAND), None);
+        assert_eq!(hem_extent(&[[0.0, f64::NAN, 0.0]], HEM_BAND), None);
+    }
 
     /// A fan of `n` triangles around the origin on the outline r(ψ).
     fn fan(n: usize, r: impl Fn(f64) -> f64) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
