@@ -6,14 +6,14 @@
 //! - The dress's skirt alone, at the defaults: ordered (the assertion).
 //! - The whole dress with bending hysteresis off: ordered (the assertion).
 //! - The whole dress at the defaults is the goal and is **missed**: cotton broad's hem
-//!   ends wider than denim's (50.0 against 49.2 cm, silk 46.2). Measured: with bending
-//!   hysteresis off denim's hem is 1.3 cm wider (50.5) and cotton's hardly moves (49.9). Likely
-//!   (not isolated by a run of its own): the spindle holds the curvature the sewing left wherever gravity's moment stays inside it
-//!   (denim's half-width HB, 0.3 gf·cm/cm = 2.9 mN·m/m, is 3.5 times the moment of its lowest
-//!   5 cm hanging 10° off the vertical, W·L²/2·sin 10° = 0.85 mN·m/m). And even without it
-//!   cotton and denim differ by 0.6 cm: the dress's slight A-line (4 cm of flare per side seam)
-//!   leaves the fabric little to decide. Kept as an ignored test stating the goal;
-//!   `docs/validation.md`, "Item 7".
+//!   ends wider than denim's (50.0 against 49.2 cm, silk 46.2). Measured: with bending hysteresis
+//!   off denim's hem is 1.3 cm wider (50.5) and cotton's hardly moves (49.9). Likely (not
+//!   isolated by a run of its own): the spindle holds the curvature the sewing left wherever
+//!   gravity's moment stays inside it (denim's half-width HB, 0.3 gf·cm/cm = 2.9 mN·m/m, is 3.5
+//!   times the moment of its lowest 5 cm hanging 10° off the vertical, W·L²/2·sin 10° = 0.85
+//!   mN·m/m). And even without it cotton and denim differ by 0.6 cm: the dress's slight A-line (4
+//!   cm of flare per side seam) leaves the fabric little to decide. Kept as an ignored test
+//!   stating the goal; `docs/validation.md`, "Item 7".
 
 use std::path::{Path, PathBuf};
 
