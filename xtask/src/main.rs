@@ -18,6 +18,8 @@
 //!   (`tradeoff_dress.{md,png}`, `tradeoff_walk.{md,png}`, about 8 minutes).
 //! - `cargo xtask figures tryon [--out DIR]` — the virtual try-on on the synthetic photographs
 //!   (photograph, fitted silhouette, composite; `tryon.md` with overlaps, errors and times).
+//! - `cargo xtask figures dress [--out DIR]` — the sewn dress in silk, cotton broad and denim at
+//!   rest, with and without bending hysteresis, side by side, and its hems' extents.
 //! - `cargo xtask figures fit [--out DIR]` — the string-identification experiments on the
 //!   synthetic objects: Table 1, Fig. 11, Table 3 and the reproduced shapes.
 //! - `cargo xtask bench-report [--out DIR] [--skip STEP…]` — every criterion bench, the
@@ -32,6 +34,7 @@
 
 mod bench_report;
 mod figures_body;
+mod figures_dress;
 mod figures_fabric;
 mod figures_fit;
 mod figures_grid;
@@ -123,6 +126,9 @@ enum FigureSet {
     /// Time against error for the sewn dress and the walk: PARTY's knobs swept, XPBD and
     /// mass-spring, against a tight PARTY reference (about 8 minutes).
     Tradeoff,
+    /// The sewn dress in silk, cotton broad and denim at rest, with and without bending
+    /// hysteresis: pictures side by side and the hems' extents (about 10 minutes).
+    Dress,
     /// Virtual try-on on the synthetic photographs: photograph, fit, composite; the frontal
     /// ambiguity; a segmented photograph (about a minute).
     Tryon,
@@ -150,6 +156,7 @@ fn main() -> Result<()> {
                 FigureSet::Stability => ("stability", figures_stability::draw_all),
                 FigureSet::Tradeoff => ("tradeoff", figures_tradeoff::draw_all),
                 FigureSet::Tryon => ("tryon", figures_tryon::draw_all),
+                FigureSet::Dress => ("dress", figures_dress::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;
