@@ -118,7 +118,7 @@ pub fn run(root: &Path, out: &Path, skip: &[Step]) -> Result<()> {
         remove_dir(&dir)?;
         eprintln!("bench-report: the benchmark scenarios");
         let only: Vec<String> = SCENARIOS.iter().map(|s| s.to_string()).collect();
-        if !crate::run_scenarios::run_all(root, &only, &dir, None)? {
+        if !crate::run_scenarios::run_all(root, &only, &[], &dir, None)? {
             bail!("a benchmark scenario failed or missed an expectation");
         }
     }

@@ -28,9 +28,10 @@
 //! - `cargo xtask knob-table [--check]` — the table of `StepParams`' knobs in `docs/solver.md`
 //!   regenerated from `StepParams::default()` and the doc comments of `params.rs`; `--check`
 //!   fails if the file is out of date (so does `cargo test --workspace`).
-//! - `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]` — every scenario of
-//!   `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on a full run
-//!   `docs/results.md` with its gallery; fails if a scenario fails or misses an expectation.
+//! - `cargo xtask run-scenarios [--only NAME…] [--skip NAME…] [--out DIR] [--shard I/N]` —
+//!   every scenario of `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on
+//!   a full run (or one with only `--skip`) `docs/results.md` with its gallery; fails if a
+//!   scenario fails or misses an expectation.
 
 mod bench_report;
 mod figures_body;
@@ -77,6 +78,10 @@ enum Command {
         /// Run only these scenarios (file names without `.ron`).
         #[arg(long, num_args = 1..)]
         only: Vec<String>,
+        /// Leave these scenarios out (file names without `.ron`); a run of every other one still
+        /// regenerates docs/results.md, listing these as not run.
+        #[arg(long, num_args = 1..)]
+        skip: Vec<String>,
         /// Output folder (created if missing); default `target/scenarios` in the repository.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -165,14 +170,19 @@ fn main() -> Result<()> {
                 eprintln!("wrote {}", written.display());
             }
         }
-        Command::RunScenarios { only, out, shard } => {
+        Command::RunScenarios {
+            only,
+            skip,
+            out,
+            shard,
+        } => {
             let shard = shard
                 .as_deref()
                 .map(run_scenarios::parse_shard)
                 .transpose()?;
             let root = repository_root();
             let out = out.unwrap_or_else(|| root.join("target/scenarios"));
-            if !run_scenarios::run_all(&root, &only, &out, shard)? {
+            if !run_scenarios::run_all(&root, &only, &skip, &out, shard)? {
                 eprintln!("some scenarios failed or missed an expectation (see above)");
                 std::process::exit(1);
             }

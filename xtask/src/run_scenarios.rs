@@ -1,9 +1,11 @@
-//! `cargo xtask run-scenarios [--only NAME…] [--out DIR] [--shard I/N]`: run every scenario of
-//! `fixtures/scenarios/` (or the named ones, or shard I of N), each into `DIR/NAME/`, then write
-//! `DIR/summary.json` and `DIR/summary.md` (scenario, wall time, key metrics, expectations met,
-//! failures). A run of every scenario also regenerates `docs/results.md` (the table and a
-//! gallery of the pictures, copied to `docs/img/results/`). Returns whether every scenario ran
-//! to its end and met its expectations.
+//! `cargo xtask run-scenarios [--only NAME…] [--skip NAME…] [--out DIR] [--shard I/N]`: run
+//! every scenario of `fixtures/scenarios/` (or the named ones, or shard I of N), each into
+//! `DIR/NAME/`, then write `DIR/summary.json` and `DIR/summary.md` (scenario, wall time, key
+//! metrics, expectations met, failures). A run of every scenario, or of every one but those
+//! `--skip` names, also regenerates `docs/results.md` (the table and a gallery of the pictures,
+//! copied to `docs/img/results/`); the skipped ones are listed there as not run, and their
+//! earlier pictures are left as they were. Returns whether every scenario run ran to its end and
+//! met its expectations.
 //!
 //! Shards: the scenarios sorted by name, shard I (1-based) of N takes every N-th from the I-th,
 //! so a batch scheduler can spread a sweep over N machines and merge the summaries.
@@ -61,6 +63,8 @@ pub struct Summary {
     pub passed: usize,
     /// Shard run, `I/N`, if any.
     pub shard: Option<String>,
+    /// Scenarios left out by `--skip` (not run, not counted).
+    pub skipped: Vec<String>,
     /// Total wall time, s.
     pub wall_s: f64,
     /// One row per scenario.
@@ -104,21 +108,25 @@ fn stem(p: &Path) -> String {
 pub fn run_all(
     root: &Path,
     only: &[String],
+    skip: &[String],
     out: &Path,
     shard: Option<(usize, usize)>,
 ) -> Result<bool> {
     let all = scenario_files(root)?;
-    for name in only {
-        if !all.iter().any(|f| stem(f) == *name) {
-            bail!(
-                "--only {name}: no fixtures/scenarios/{name}.ron (have: {})",
-                all.iter().map(|f| stem(f)).collect::<Vec<_>>().join(", ")
-            );
+    for (flag, names) in [("--only", only), ("--skip", skip)] {
+        for name in names {
+            if !all.iter().any(|f| stem(f) == *name) {
+                bail!(
+                    "{flag} {name}: no fixtures/scenarios/{name}.ron (have: {})",
+                    all.iter().map(|f| stem(f)).collect::<Vec<_>>().join(", ")
+                );
+            }
         }
     }
     let selected: Vec<&PathBuf> = all
         .iter()
         .filter(|f| only.is_empty() || only.contains(&stem(f)))
+        .filter(|f| !skip.contains(&stem(f)))
         .enumerate()
         .filter(|(k, _)| shard.is_none_or(|(i, n)| k % n == i - 1))
         .map(|(_, f)| f)
@@ -138,6 +146,7 @@ pub fn run_all(
         scenarios: rows.len(),
         passed: rows.iter().filter(|r| r.passed()).count(),
         shard: shard.map(|(i, n)| format!("{i}/{n}")),
+        skipped: skip.to_vec(),
         wall_s: clock.elapsed().as_secs_f64(),
         rows,
     };
@@ -255,14 +264,20 @@ fn key_metrics(r: &Report) -> String {
         v.map_or("–".to_string(), |v| format!("{v:.digits$}{unit}"))
     };
     match r.scenario.kind.as_str() {
-        "Garment" => format!(
-            "sewn {}/{} pairs{}, deepest inside body {}, final strain error {}",
-            f(m("pairs_sewn"), 0, ""),
-            f(m("pairs"), 0, ""),
-            m("sewn_at_s").map_or(String::new(), |t| format!(" at {t:.2} s")),
-            f(m("max_penetration_m").map(|v| v * 1e3), 1, " mm"),
-            f(m("final_strain_error"), 3, ""),
-        ),
+        "Garment" => {
+            format!(
+                "sewn {}/{} pairs{}, deepest inside body {}, final strain error {}",
+                f(m("pairs_sewn"), 0, ""),
+                f(m("pairs"), 0, ""),
+                m("sewn_at_s").map_or(String::new(), |t| format!(" at {t:.2} s")),
+                f(m("max_penetration_m").map(|v| v * 1e3), 1, " mm"),
+                f(m("final_strain_error"), 3, ""),
+            ) + &m("hem_width_m")
+                .zip(m("hem_depth_m"))
+                .map_or(String::new(), |(w, d)| {
+                    format!(", hem {:.1} × {:.1} cm", w * 100.0, d * 100.0)
+                })
+        }
         "Drape" => format!(
             "DC {}, {} nodes, {}",
             f(m("drape_coefficient_percent"), 1, " %"),
@@ -354,6 +369,17 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
             .map_or(String::new(), |x| format!(" (shard {x})")),
         s.wall_s
     );
+    if !s.skipped.is_empty() {
+        let _ = writeln!(
+            md,
+            "Not run (left out with `--skip`; why: docs/validation.md): {}.\n",
+            s.skipped
+                .iter()
+                .map(|n| format!("`{n}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     let _ = writeln!(
         md,
         "| scenario | kind | wall s | steps | simulated s | key metrics | expectations | failure |"
