@@ -41,15 +41,7 @@ impl Dressed {
 
     /// Root-mean-square node speed between the last two frames, m/s.
     fn speed(&self) -> f64 {
-        let f = &self.run.frames;
-        let (a, b) = (&f[f.len() - 1], &f[f.len() - 2]);
-        let sum: f64 = a
-            .cloth
-            .iter()
-            .zip(&b.cloth)
-            .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>())
-            .sum();
-        (sum / a.cloth.len() as f64).sqrt() / (a.time - b.time)
+        self.run.final_rms_speed().unwrap_or(f64::NAN)
     }
 }
 

@@ -63,6 +63,28 @@ pub struct GarmentRun {
     pub warnings: Vec<String>,
 }
 
+impl GarmentRun {
+    /// Root-mean-square speed of the cloth's nodes between the last two recorded frames, m/s:
+    /// whether the garment has come to rest. `None` with fewer than two frames or without
+    /// cloth.
+    pub fn final_rms_speed(&self) -> Option<f64> {
+        let [.., before, last] = self.frames.as_slice() else {
+            return None;
+        };
+        let dt = last.time - before.time;
+        if last.cloth.is_empty() || last.cloth.len() != before.cloth.len() || dt <= 0.0 {
+            return None;
+        }
+        let sum: f64 = last
+            .cloth
+            .iter()
+            .zip(&before.cloth)
+            .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>())
+            .sum();
+        Some((sum / last.cloth.len() as f64).sqrt() / dt)
+    }
+}
+
 /// Load, place, dress, settle and move: the whole garment scene. `base` is the folder relative
 /// paths are resolved against; `progress` receives the fraction of the planned time done.
 pub fn run_garment(
@@ -159,4 +181,60 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
         run.frames.push(frame(&sim));
     }
     Ok(run)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(time: f64, cloth: Vec<[f64; 3]>) -> Frame {
+        Frame {
+            time,
+            phase: Phase::Settling,
+            cloth,
+            body: Vec::new(),
+        }
+    }
+
+    fn run_with(frames: Vec<Frame>) -> GarmentRun {
+        GarmentRun {
+            cloth_triangles: Vec::new(),
+            body_triangles: Vec::new(),
+            frames,
+            pairs: (0, 0),
+            sewn_at: None,
+            steps: 0,
+            wall_seconds: 0.0,
+            timings: Timings::default(),
+            max_penetration: 0.0,
+            steps_with_penetration: 0,
+            max_strain_error: (0.0, 0.0),
+            kinetic_energy: 0.0,
+            max_motion_energy: 0.0,
+            convergence: Convergence::not_reported("test", 0),
+            failure: None,
+            warnings: Vec::new(),
+        }
+    }
+
+    /// Two nodes, one moved 3 mm in x and 4 mm in z between frames 0.04 s apart (5 mm: 0.125
+    /// m/s), the other still: the root mean square is 0.125/√2 m/s; earlier frames do not count.
+    #[test]
+    fn final_rms_speed_is_the_root_mean_square_over_the_last_two_frames() {
+        let run = run_with(vec![
+            frame(0.0, vec![[9.0, 9.0, 9.0], [9.0, 9.0, 9.0]]),
+            frame(1.0, vec![[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]),
+            frame(1.04, vec![[0.003, 0.0, 0.004], [1.0, 1.0, 1.0]]),
+        ]);
+        let v = run.final_rms_speed().expect("two frames");
+        assert!((v - 0.125 / 2f64.sqrt()).abs() < 1e-12, "{v}");
+        assert_eq!(
+            run_with(vec![frame(0.0, vec![[0.0; 3]])]).final_rms_speed(),
+            None
+        );
+        assert_eq!(
+            run_with(vec![frame(0.0, vec![]), frame(0.04, vec![])]).final_rms_speed(),
+            None
+        );
+    }
 }

@@ -558,6 +558,7 @@ fn garment(
 
 /// A garment run as a [`Simulated`]: frames, body, metrics and warnings.
 fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
+    let speed = run.final_rms_speed();
     let mut cloth = Animation::default();
     let mut body = Animation::default();
     for f in &run.frames {
@@ -621,6 +622,7 @@ fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
     });
     put("hem_width_m", hem.map(|h| h.width));
     put("hem_depth_m", hem.map(|h| h.depth));
+    put("final_rms_speed_m_s", speed);
     Simulated {
         fabric: String::new(),
         cloth_triangles: run.cloth_triangles,

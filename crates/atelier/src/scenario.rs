@@ -122,6 +122,7 @@ impl ScenarioKind {
                 "nodes_below_body",
                 "hem_width_m",
                 "hem_depth_m",
+                "final_rms_speed_m_s",
                 "frames",
                 crate::convergence::UNCONVERGED_FRACTION,
             ],

@@ -74,19 +74,8 @@ fn hang(scenario: &str, fabric: &'static str, hysteresis: bool) -> Hung {
         100.0 * unconverged,
         c.steps
     );
-    let [.., before, last] = run.frames.as_slice() else {
-        panic!("frames recorded")
-    };
-    let dt = last.time - before.time;
-    let speed = (last
-        .cloth
-        .iter()
-        .zip(&before.cloth)
-        .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>())
-        .sum::<f64>()
-        / last.cloth.len() as f64)
-        .sqrt()
-        / dt;
+    let speed = run.final_rms_speed().expect("two frames recorded");
+    let last = run.frames.last().expect("frames recorded");
     assert!(
         speed < AT_REST,
         "{scenario} in {fabric} still moves at {:.1} mm/s (rms) at the end",
