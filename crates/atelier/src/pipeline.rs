@@ -64,6 +64,34 @@ pub struct GarmentRun {
 }
 
 impl GarmentRun {
+    /// A run before its first step: the meshes, the frames so far and the pairs, nothing
+    /// measured yet.
+    fn started(
+        cloth_triangles: Vec<[u32; 3]>,
+        body_triangles: Vec<[u32; 3]>,
+        frames: Vec<Frame>,
+        pairs: (usize, usize),
+    ) -> Self {
+        Self {
+            cloth_triangles,
+            body_triangles,
+            frames,
+            pairs,
+            sewn_at: None,
+            steps: 0,
+            wall_seconds: 0.0,
+            timings: Timings::default(),
+            max_penetration: 0.0,
+            steps_with_penetration: 0,
+            max_strain_error: (0.0, 0.0),
+            kinetic_energy: 0.0,
+            max_motion_energy: 0.0,
+            convergence: Convergence::not_reported(solvers::PARTY, 0),
+            failure: None,
+            warnings: Vec::new(),
+        }
+    }
+
     /// Root-mean-square speed of the cloth's nodes between the last two recorded frames, m/s:
     /// whether the garment has come to rest. `None` with fewer than two frames or without
     /// cloth.
@@ -115,24 +143,12 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
         cloth: to3(&sim.state().positions),
         body: to3(sim.body_positions()),
     };
-    let mut run = GarmentRun {
-        cloth_triangles: sim.cloth_triangles().to_vec(),
-        body_triangles: sim.body_triangles().to_vec(),
-        frames: vec![frame(&sim)],
-        pairs: sim.sewing_progress(),
-        sewn_at: None,
-        steps: 0,
-        wall_seconds: 0.0,
-        timings: Timings::default(),
-        max_penetration: 0.0,
-        steps_with_penetration: 0,
-        max_strain_error: (0.0, 0.0),
-        kinetic_energy: 0.0,
-        max_motion_energy: 0.0,
-        convergence: Convergence::not_reported(solvers::PARTY, 0),
-        failure: None,
-        warnings: Vec::new(),
-    };
+    let mut run = GarmentRun::started(
+        sim.cloth_triangles().to_vec(),
+        sim.body_triangles().to_vec(),
+        vec![frame(&sim)],
+        sim.sewing_progress(),
+    );
     let planned = sim.planned_time().max(f64::MIN_POSITIVE);
     let mut next_frame = frame_interval;
     let clock = Instant::now();
@@ -197,24 +213,7 @@ mod tests {
     }
 
     fn run_with(frames: Vec<Frame>) -> GarmentRun {
-        GarmentRun {
-            cloth_triangles: Vec::new(),
-            body_triangles: Vec::new(),
-            frames,
-            pairs: (0, 0),
-            sewn_at: None,
-            steps: 0,
-            wall_seconds: 0.0,
-            timings: Timings::default(),
-            max_penetration: 0.0,
-            steps_with_penetration: 0,
-            max_strain_error: (0.0, 0.0),
-            kinetic_energy: 0.0,
-            max_motion_energy: 0.0,
-            convergence: Convergence::not_reported("test", 0),
-            failure: None,
-            warnings: Vec::new(),
-        }
+        GarmentRun::started(Vec::new(), Vec::new(), frames, (0, 0))
     }
 
     /// Two nodes, one moved 3 mm in x and 4 mm in z between frames 0.04 s apart (5 mm: 0.125
