@@ -322,8 +322,9 @@ pub fn axial_strains<'a>(
 /// and 10 cm, their depths by up to 0.7 cm).
 pub const HEM_BAND: f64 = 0.03;
 
-/// The silhouette of a hanging garment's hem, in the body's frame (x the body's left, y up,
-/// z forward): the extent of the nodes within `band` of the lowest node along x (its width in
+/// The silhouette of a hanging garment's hem, along the scene's axes (y up; for the mannequin
+/// standing at rest x is its left and z its front, so a walk that turns it changes what x and
+/// z mean): the extent of the nodes within `band` of the lowest node along x (its width in
 /// the front view) and along z (its depth in the side view). `None` without nodes or with a
 /// non-finite position.
 #[derive(Clone, Copy, Debug, PartialEq)]
