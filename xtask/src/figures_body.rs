@@ -8,7 +8,7 @@ use atelier_body::range::{RenderParams, render_views};
 use atelier_body::{Body, LabelledMesh, Motion};
 use plotters::prelude::*;
 
-use crate::plot::png;
+use crate::plot::{blit, png};
 use atelier::picture::{Fit, View, part_colour, render, screen_box};
 
 use crate::plot::to_rgb;
@@ -92,16 +92,7 @@ fn poses(body: &Body, motion: &Motion, times: &[f64], title: &str, path: &Path) 
                         h,
                     );
                     let pixels = render(m, &body.rest.triangles, &colour, view, fit, w, h);
-                    for y in 0..h {
-                        for x in 0..w {
-                            if let Some(rgb) = pixels[y * w + x] {
-                                root.draw_pixel(
-                                    ((k * w + x) as i32, (row * h + y + 40) as i32),
-                                    &to_rgb(rgb),
-                                )?;
-                            }
-                        }
-                    }
+                    blit(root, &pixels, w, (k * w, row * h + 40))?;
                     let label = format!(
                         "t = {t:.3} s, {}",
                         if row == 0 { "front" } else { "left side" }

@@ -15,7 +15,7 @@ use atelier_solver::metrics::{HEM_BAND, hem_extent};
 use plotters::prelude::*;
 use rayon::prelude::*;
 
-use crate::plot::{png, to_rgb};
+use crate::plot::{blit, png};
 
 /// The fabrics, by fixture file, in the order drawn.
 const FABRICS: [&str; 3] = ["silk", "cotton_broad", "denim"];
@@ -141,16 +141,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
                     ((x0 + 10) as i32, (y0 + 8) as i32),
                     ("sans-serif", 16).into_font(),
                 ))?;
-                for y in 0..h {
-                    for x in 0..2 * w {
-                        if let Some(rgb) = pixels[y * 2 * w + x] {
-                            area.draw_pixel(
-                                ((x0 + x) as i32, (y0 + label + y) as i32),
-                                &to_rgb(rgb),
-                            )?;
-                        }
-                    }
-                }
+                blit(area, &pixels, 2 * w, (x0, y0 + label))?;
             }
             Ok(())
         },

@@ -9,7 +9,7 @@ use atelier_grid::range::synthetic::Mannequin;
 use atelier_grid::range::{BodyGridParams, BodyMesh, ErrorImage, Part, grid_body, measure_error};
 use plotters::prelude::*;
 
-use crate::plot::png;
+use crate::plot::{blit, png};
 use atelier::picture::{Fit, View, part_colour, render, screen_box};
 
 use crate::plot::to_rgb;
@@ -67,13 +67,7 @@ fn parts(mesh: &BodyMesh, nodes: usize, triangles: usize, path: &Path) -> Result
             ("sans-serif", 20).into_font(),
         ))?;
         for (v, pixels) in views.iter().enumerate() {
-            for y in 0..h {
-                for x in 0..w {
-                    if let Some(c) = pixels[y * w + x] {
-                        root.draw_pixel(((v * w + x) as i32, (y + 50) as i32), &to_rgb(c))?;
-                    }
-                }
-            }
+            blit(root, pixels, w, (v * w, 50))?;
         }
         for (k, p) in Part::ALL.iter().enumerate() {
             let y = 70 + 26 * k as i32;

@@ -14,6 +14,23 @@ pub fn register_font() -> Result<()> {
         .map_err(|_| anyhow!("the bundled font could not be loaded"))
 }
 
+/// Draw a rendered picture (`w` pixels a row, row 0 at the top; `None` pixels left as they are)
+/// into `area` with its top left corner at `at`.
+pub fn blit(
+    area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    pixels: &[Option<[f64; 3]>],
+    w: usize,
+    at: (usize, usize),
+) -> Result<()> {
+    for (k, p) in pixels.iter().enumerate() {
+        if let Some(rgb) = p {
+            let (x, y) = (at.0 + k % w, at.1 + k / w);
+            area.draw_pixel((x as i32, y as i32), &to_rgb(*rgb))?;
+        }
+    }
+    Ok(())
+}
+
 /// Draw into a PNG at `path`: the drawing goes to a temporary file beside it, renamed over
 /// `path` only when complete, so a failure leaves an earlier figure intact.
 pub fn png(
