@@ -1,11 +1,19 @@
 //! Line charts for the reports of virtual tests: a KES loop, simulated against the fabric's own,
 //! drawn with plotters and the bundled DejaVu Sans (no system fonts needed), written
-//! atomically.
+//! atomically. The data types are always here; drawing needs the `charts` feature (plotters),
+//! which the command-line program and xtask turn on ([`DRAWN`]).
 
+#[cfg(feature = "charts")]
 use std::path::Path;
+#[cfg(feature = "charts")]
 use std::sync::OnceLock;
 
+#[cfg(feature = "charts")]
 use plotters::prelude::*;
+
+/// Whether this build draws charts (the `charts` feature); without it a run leaves the chart
+/// pictures out and says so in its warnings.
+pub const DRAWN: bool = cfg!(feature = "charts");
 
 /// One curve of a chart.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,6 +41,7 @@ pub struct Chart {
     pub equal_aspect: bool,
 }
 
+#[cfg(feature = "charts")]
 /// Register the bundled font once; false when it cannot be loaded.
 fn font() -> bool {
     static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
@@ -42,12 +51,14 @@ fn font() -> bool {
     })
 }
 
+#[cfg(feature = "charts")]
 const COLOURS: [RGBColor; 3] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),
 ];
 
+#[cfg(feature = "charts")]
 /// Draw `chart` into a PNG of `size` pixels at `path` (a temporary file beside it, renamed when
 /// complete).
 pub fn write_chart(path: &Path, chart: &Chart, size: (u32, u32)) -> std::io::Result<()> {
@@ -67,6 +78,7 @@ pub fn write_chart(path: &Path, chart: &Chart, size: (u32, u32)) -> std::io::Res
     }
 }
 
+#[cfg(feature = "charts")]
 fn draw(
     file: &Path,
     chart: &Chart,

@@ -290,9 +290,8 @@ fn write_outputs(
             .map_err(io(path))?;
         written.push(outputs::PARAMETERS.into());
         if let Some(chart) = &sim.chart {
-            let path = out.join(outputs::PICTURE);
-            crate::chart::write_chart(&path, chart, (2 * w as u32, h as u32)).map_err(io(path))?;
-            written.push(outputs::PICTURE.into());
+            let size = (2 * w as u32, h as u32);
+            write_chart(out, outputs::PICTURE, chart, size, &mut written, &mut warnings)?;
         }
         return Ok((written, warnings));
     }
@@ -341,7 +340,7 @@ fn write_outputs(
 
     let (w, h) = options.picture;
     if let Some(wet) = &sim.wet {
-        write_wet_outputs(wet, &sim.cloth_triangles, out, (w, h), &mut written)?;
+        write_wet_outputs(wet, &sim.cloth_triangles, out, (w, h), &mut written, &mut warnings)?;
         return Ok((written, warnings));
     }
     let solid_final = solid_part
@@ -363,13 +362,19 @@ fn write_outputs(
         }
         _ => draw(&|p| *p, w, h),
     };
-    let path = out.join(outputs::PICTURE);
     match &sim.chart {
-        Some(chart) => crate::chart::write_chart(&path, chart, (2 * w as u32, h as u32)),
-        None => crate::picture::write_png(&path, &pixels, 2 * w, h, [1.0; 3]),
+        Some(chart) if crate::chart::DRAWN => {
+            let size = (2 * w as u32, h as u32);
+            write_chart(out, outputs::PICTURE, chart, size, &mut written, &mut warnings)?;
+        }
+        _ => {
+            // Without the `charts` feature a virtual test's chart gives way to the cloth's picture.
+            let path = out.join(outputs::PICTURE);
+            crate::picture::write_png(&path, &pixels, 2 * w, h, [1.0; 3])
+                .map_err(|source| RunError::Output { path, source })?;
+            written.push(outputs::PICTURE.into());
+        }
     }
-    .map_err(|source| RunError::Output { path, source })?;
-    written.push(outputs::PICTURE.into());
     if style == PictureStyle::WithTop {
         // Seen from above: screen x = x, screen y = −z (forward is down), depth y.
         let pixels = draw(&|p| [p[0], -p[2], p[1]], h, h);
@@ -393,6 +398,7 @@ fn write_wet_outputs(
     out: &Path,
     (w, h): (usize, usize),
     written: &mut Vec<String>,
+    warnings: &mut Vec<String>,
 ) -> Result<(), RunError> {
     let io = |path: PathBuf| move |source| RunError::Output { path, source };
     // One height scale for both runs' pictures.
@@ -413,9 +419,36 @@ fn write_wet_outputs(
     atelier_fabric::files::write_atomic(&path, wet.series_csv.as_bytes()).map_err(io(path))?;
     written.push(outputs::SERIES.into());
     for (name, chart) in &wet.charts {
+        write_chart(out, name, chart, (2 * w as u32, h as u32), written, warnings)?;
+    }
+    Ok(())
+}
+
+/// Draw `chart` into `out/name` and list it as written; without the `charts` feature, a warning
+/// that it was left out instead.
+fn write_chart(
+    out: &Path,
+    name: &str,
+    chart: &crate::chart::Chart,
+    size: (u32, u32),
+    written: &mut Vec<String>,
+    warnings: &mut Vec<String>,
+) -> Result<(), RunError> {
+    #[cfg(feature = "charts")]
+    {
+        let _ = warnings;
         let path = out.join(name);
-        crate::chart::write_chart(&path, chart, (2 * w as u32, h as u32)).map_err(io(path))?;
-        written.push((*name).into());
+        crate::chart::write_chart(&path, chart, size)
+            .map_err(|source| RunError::Output { path, source })?;
+        written.push(name.into());
+    }
+    #[cfg(not(feature = "charts"))]
+    {
+        let _ = (out, chart, size, written);
+        warnings.push(format!(
+            "{name} ({}) not drawn: atelier was built without its `charts` feature",
+            chart.title
+        ));
     }
     Ok(())
 }

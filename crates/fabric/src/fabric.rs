@@ -189,6 +189,14 @@ pub struct Fabric {
     pub shear: Option<Shear>,
 }
 
+impl ShearCurve {
+    /// Build from a fabric's loading branches (the 45° bias; 135° is not used): the shear its
+    /// tensile loops imply ([`ShearCurve::from_tensile`]).
+    pub fn from_fabric(fabric: &Fabric) -> Self {
+        Self::from_tensile(&fabric.tensile)
+    }
+}
+
 impl Fabric {
     /// Load a fabric file (RON).
     pub fn load(path: &Path) -> Result<Self, FileError> {

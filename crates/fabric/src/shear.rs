@@ -47,9 +47,9 @@
 //!
 //! Units: γ in rad, τ in N/m, G in N/(m·rad).
 
+use crate::anisotropy::Directions;
 use crate::error::{ErrorKind, InvalidValue};
-use crate::fabric::Fabric;
-use crate::tensile::Branch;
+use crate::tensile::{Branch, TensileLoop};
 use crate::units;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
@@ -879,9 +879,9 @@ pub struct ShearCurve {
 }
 
 impl ShearCurve {
-    /// Build from a fabric's loading branches (the 45° bias; 135° is not used).
-    pub fn from_fabric(fabric: &Fabric) -> Self {
-        let d = &fabric.tensile;
+    /// Build from a fabric's tensile loops' loading branches (the 45° bias; 135° is not used);
+    /// [`ShearCurve::from_fabric`] takes them from a fabric.
+    pub fn from_tensile(d: &Directions<TensileLoop>) -> Self {
         let tau_max = 0.5
             * d.bias45
                 .max_force()

@@ -10,6 +10,7 @@
 //! - [`ClothState`]: positions, velocities, warm-start forces, hysteresis states;
 //! - [`Solver::step`]: one step, with [`StepParams`] and a [`StepReport`] of diagnostics.
 
+pub mod air;
 pub mod baselines;
 pub mod bend_angle;
 pub mod cloth;

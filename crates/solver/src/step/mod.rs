@@ -70,7 +70,7 @@ pub struct Solver {
     /// the external forces, and the shape iterations take the air's pressure at the end of the
     /// step as a compliant volume constraint (`wet::pressure`, "Large steps"). None (the
     /// default): no pressure, and nothing of it runs.
-    pub pressure: Option<crate::wet::PressureStage>,
+    pub pressure: Option<crate::air::PressureStage>,
 }
 
 impl Solver {

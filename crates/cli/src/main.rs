@@ -22,7 +22,7 @@ use atelier::scenario::Scenario;
 use clap::{Parser, Subcommand};
 
 /// The built-in default scenario (`fixtures/scenarios/default.ron`), embedded at build time.
-const DEFAULT_SCENARIO: &str = include_str!("../../../../fixtures/scenarios/default.ron");
+const DEFAULT_SCENARIO: &str = include_str!("../../../fixtures/scenarios/default.ron");
 
 /// The folder the default scenario's relative paths are resolved against: the repository's
 /// `fixtures/scenarios`, found through the crate's source location at build time (the garment,
