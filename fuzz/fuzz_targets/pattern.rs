@@ -1,7 +1,7 @@
 //! cargo-fuzz target: the pattern loader on arbitrary bytes (read as UTF-8, lossily). docs/hostile.md.
 #![no_main]
 
-#[path = "../../crates/atelier/tests/loaders/mod.rs"]
+#[path = "../../crates/cli/tests/loaders/mod.rs"]
 mod loaders;
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {

@@ -2,7 +2,7 @@
 //! docs/hostile.md.
 #![no_main]
 
-#[path = "../../crates/atelier/tests/loaders/mod.rs"]
+#[path = "../../crates/cli/tests/loaders/mod.rs"]
 mod loaders;
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {

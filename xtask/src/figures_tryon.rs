@@ -1,5 +1,5 @@
 //! The try-on's figures and table (issue 11; `docs/tryon.md`): each synthetic photograph of
-//! `atelier::tryon::examples` tried on with the sewn skirt (the sleeved dress's cost:
+//! `atelier_tryon::examples` tried on with the sewn skirt (the sleeved dress's cost:
 //! `docs/performance.md`) — photograph, fitted silhouette over the mask, composite, side by side (`tryon_<name>.png`) — and `tryon.md` with the overlap
 //! before and after the fit, the worst joint-angle error, the size and the times. Then the
 //! same photographs taken exactly from the front, fitted only, to measure what a frontal
@@ -10,12 +10,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use atelier::run::RunOptions;
-use atelier::tryon::camera::Camera;
-use atelier::tryon::examples::{Example, examples};
-use atelier::tryon::image::{Mask, encode, load_photo};
-use atelier::tryon::pose::{FITTED, FitOptions, PoseFile, PoseFit, fit_pose, synthetic_photo};
-use atelier::tryon::{TryonInputs, tryon};
 use atelier_body::build::jis_9ar_description;
+use atelier_tryon::camera::Camera;
+use atelier_tryon::examples::{Example, examples};
+use atelier_tryon::image::{Mask, encode, load_photo};
+use atelier_tryon::pose::{FITTED, FitOptions, PoseFile, PoseFit, fit_pose, synthetic_photo};
+use atelier_tryon::{TryonInputs, tryon};
 
 /// The largest error over the fitted angles, degrees, and the joint it is at.
 fn worst_angle(fit: &[[f64; 3]; 17], truth: &[[f64; 3]; 17]) -> (f64, String) {

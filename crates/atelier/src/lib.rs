@@ -1,15 +1,29 @@
 //! # atelier
 //!
-//! The facade (issue 7, in progress): a garment's gridded panels assembled into one cloth with
-//! its seams ([`assemble`]), and dressing by sewing ([`sewing`], thesis §5.6): seam node pairs
-//! drawn together with gravity off, each pair sewn once it is closer than a threshold; and
-//! [`validate`], the checks behind `atelier validate FILE…`.
+//! The facade of the atelier workspace: it composes the fabric, grid, body, collision, solver
+//! and fit crates into scenes and runs, and computes nothing of its own physics.
+//!
+//! - A garment: gridded panels assembled into one cloth with its seams ([`assemble`]), placed
+//!   round the body ([`place`]), dressed by sewing ([`sewing`], thesis §5.6) or by one-sided
+//!   contact, then walked; [`Scene`] and [`Simulation`] run it step by step ([`pipeline`] holds
+//!   the phases).
+//! - Scenario files ([`scenario`]) and their runs ([`run`]): the report ([`report`], with
+//!   [`convergence`]), exports ([`export`]: OBJ, PLY, glTF) and pictures ([`picture`], the one
+//!   rasteriser; [`camera`]; [`chart`], drawn only with the `charts` feature).
+//! - Virtual tests and the other scene kinds run through the same runner: wet cloth ([`wet`]),
+//!   string identification ([`fit`]) and the turned strip ([`strip`]).
+//!
+//! The command-line program is the `atelier-cli` crate; the try-on from a photograph is
+//! `atelier-tryon`. A library user depends on this crate alone and pulls neither clap,
+//! indicatif nor plotters (unless the `charts` feature is turned on).
 
 pub mod assemble;
+pub mod camera;
 pub mod chart;
 pub mod convergence;
 pub mod export;
 pub mod fit;
+pub mod outcome;
 pub mod picture;
 pub mod pipeline;
 pub mod place;
@@ -20,8 +34,6 @@ pub mod scene;
 pub mod sewing;
 pub mod simulation;
 pub mod strip;
-pub mod tryon;
-pub mod validate;
 pub mod wet;
 
 pub use assemble::{AssembleError, GarmentCloth};

@@ -8,10 +8,13 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use atelier_body::build::Sizes;
 use serde::{Deserialize, Serialize};
 
+use crate::camera::Camera;
 use crate::convergence::{Convergence, UNCONVERGED_FRACTION};
-use crate::run::{RunError, Simulated, check_expectations};
+pub use crate::outcome::Comparison;
+use crate::outcome::{RunError, Simulated};
 use crate::scenario::Scenario;
 
 /// The scenario a report is about.
@@ -57,39 +60,6 @@ pub struct StageSeconds {
     pub pressure: f64,
     /// Sum of the stages.
     pub total: f64,
-}
-
-/// A second run of the same scene on another solver (wet scenes), with its cost (its metrics
-/// are the report's `compare_*` metrics).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Comparison {
-    /// `yamada` or `party`.
-    pub solver: String,
-    /// Its time step, s.
-    pub dt_s: f64,
-    /// Steps taken.
-    pub steps: usize,
-    /// Simulated time reached, s.
-    pub simulated_s: f64,
-    /// Wall time of its steps, s.
-    pub wall_s: f64,
-    /// Of which the pressure force, s.
-    pub pressure_s: f64,
-    /// The failure that ended it early (`null`: none).
-    pub failure: Option<String>,
-    /// Whether its steps converged (its counts `null` when its solver does not report it).
-    #[serde(default)]
-    pub convergence: Option<Convergence>,
-}
-
-impl Comparison {
-    /// The warning about the compared run's unconverged steps (`the compared party run: …`),
-    /// if some step did not converge.
-    pub fn convergence_warning(&self) -> Option<String> {
-        let w = self.convergence.as_ref().and_then(Convergence::warning)?;
-        Some(format!("the compared {} run: {w}", self.solver))
-    }
 }
 
 /// One expectation and its outcome.
@@ -161,7 +131,7 @@ pub struct Report {
     pub comparison: Option<Comparison>,
     /// The try-on's fit and composite (`atelier tryon` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tryon: Option<crate::tryon::TryonInfo>,
+    pub tryon: Option<TryonInfo>,
 }
 
 impl Report {
@@ -246,10 +216,7 @@ impl Report {
         self.failure.is_none()
             && self.expectations_met
             && !self.unconverged()
-            && self
-                .tryon
-                .as_ref()
-                .is_none_or(|t| t.iou_after >= crate::tryon::LOW_IOU)
+            && self.tryon.as_ref().is_none_or(|t| t.iou_after >= LOW_IOU)
     }
 
     /// Whether some step did not converge — the run's, or a wet scene's compared run's (its
@@ -328,4 +295,67 @@ impl Report {
             }
         }
     }
+}
+
+/// The try-on (`atelier-tryon`): below this silhouette overlap the fit is reported as failed (a warning and exit status 2).
+pub const LOW_IOU: f64 = 0.8;
+
+/// The try-on's part of `report.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TryonInfo {
+    /// The photograph, as given.
+    pub photo: String,
+    /// The mask, as given; `null` when the background was segmented.
+    pub mask: Option<String>,
+    /// Pixels of the person in the mask.
+    pub mask_pixels: usize,
+    /// Silhouette overlap (intersection over union) at the start: the standard (or given)
+    /// pose, the camera put on the mask's box.
+    pub iou_before: f64,
+    /// Silhouette overlap fitted.
+    pub iou_after: f64,
+    /// Wall time of the fit, s.
+    pub fit_s: f64,
+    /// Silhouettes rendered by the fit.
+    pub evaluations: usize,
+    /// How the fit's last minimisation ended.
+    pub termination: String,
+    /// The fitted camera.
+    pub camera: Camera,
+    /// The fitted sizes.
+    pub sizes: Sizes,
+    /// Fitted joint angles (α, β, γ), degrees, by part.
+    pub joints: BTreeMap<String, (f64, f64, f64)>,
+    /// Length of the motion from the standard pose to the fitted one, s.
+    pub motion_s: f64,
+    /// Pixels of the person the fitted mannequin does not cover (red in `overlay.png`): where
+    /// the person is wider than the mannequin, the person can show beside the garment (the
+    /// composite does not paint the photograph's background over them).
+    pub person_outside_mannequin_px: usize,
+    /// Pixels of the photograph the garment covers.
+    pub garment_pixels: usize,
+    /// The light's direction (body frame).
+    pub light: [f64; 3],
+}
+
+/// Check each expectation against the metrics.
+pub fn check_expectations(
+    scenario: &Scenario,
+    metrics: &BTreeMap<String, Option<f64>>,
+) -> Vec<ExpectationResult> {
+    scenario
+        .expectations
+        .iter()
+        .map(|e| {
+            let value = metrics.get(&e.metric).copied().flatten();
+            ExpectationResult {
+                metric: e.metric.clone(),
+                min: e.min,
+                max: e.max,
+                value,
+                met: e.met_by(value),
+            }
+        })
+        .collect()
 }

@@ -26,82 +26,15 @@ use crate::convergence::{Convergence, Tally, UNCONVERGED_FRACTION, solvers};
 use crate::export::{
     Animation, ExportError, FrameSelection, GlbOptions, MeshPart, write_glb, write_obj, write_ply,
 };
+pub use crate::outcome::{RunError, Simulated, Solid};
 use crate::pipeline::run_garment;
-use crate::report::{ExpectationResult, Report};
+use crate::report::Report;
+pub use crate::report::check_expectations;
 use crate::scenario::{
     CantileverSpec, CatenarySpec, DrapeSpec, KesBendingSpec, KesTensileSpec, Scenario,
     ScenarioKind, StripDirection, Tester,
 };
 use crate::simulation::Timings;
-
-/// Why a scenario could not be run or its outputs not written. (A run that diverges is not an
-/// error: it is a [`Simulated`] with a failure, and its outputs are written.)
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    /// The scene could not be set up (a file it names, a parameter out of range).
-    #[error("{0}")]
-    Setup(String),
-    /// The output folder could not be created or written.
-    #[error("cannot write {}: {source}", path.display())]
-    Output {
-        /// The folder or file.
-        path: PathBuf,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
-    },
-}
-
-/// A fixed part drawn and exported with the cloth: the body, or a drape tester's support.
-#[derive(Clone, Debug)]
-pub struct Solid {
-    /// Part name in the exports (`body`, `support`, `platform`).
-    pub name: &'static str,
-    /// Triangles (vertex indices), outward.
-    pub triangles: Vec<[u32; 3]>,
-    /// Its positions over the run (one frame when it does not move).
-    pub motion: Animation,
-}
-
-/// What a simulation produced, before anything is written.
-#[derive(Clone, Debug)]
-pub struct Simulated {
-    /// The fabric's name.
-    pub fabric: String,
-    /// Cloth triangles (node indices).
-    pub cloth_triangles: Vec<[u32; 3]>,
-    /// Cloth node positions over the run (y up), the last frame the final or last good state.
-    pub cloth: Animation,
-    /// The body or the tester, if any.
-    pub solid: Option<Solid>,
-    /// Steps taken.
-    pub steps: usize,
-    /// Time step, s.
-    pub dt: f64,
-    /// Simulated time reached, s.
-    pub simulated: f64,
-    /// Wall time of the steps, s.
-    pub wall_seconds: f64,
-    /// Wall time per stage, summed over the steps.
-    pub timings: Timings,
-    /// Metrics by name (see [`ScenarioKind::metric_names`]); `None` when not measured (for
-    /// example a drape coefficient after a failed step).
-    pub metrics: BTreeMap<String, Option<f64>>,
-    /// Things the user should know.
-    pub warnings: Vec<String>,
-    /// The failure that ended the run early.
-    pub failure: Option<String>,
-    /// A chart drawn instead of the final state's views (the virtual KES tests: the loop).
-    pub chart: Option<crate::chart::Chart>,
-    /// The series, charts and second run of a wet scene.
-    pub wet: Option<Box<crate::wet::WetOutputs>>,
-    /// The fitted parameters of a string identification.
-    pub fit: Option<Box<crate::fit::FitOutputs>>,
-    /// The compared run of a wet scene.
-    pub comparison: Option<crate::report::Comparison>,
-    /// Whether the steps converged (`None`: no solver stepped, the string identification).
-    pub convergence: Option<Convergence>,
-}
 
 /// Options of [`run`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -291,7 +224,14 @@ fn write_outputs(
         written.push(outputs::PARAMETERS.into());
         if let Some(chart) = &sim.chart {
             let size = (2 * w as u32, h as u32);
-            write_chart(out, outputs::PICTURE, chart, size, &mut written, &mut warnings)?;
+            write_chart(
+                out,
+                outputs::PICTURE,
+                chart,
+                size,
+                &mut written,
+                &mut warnings,
+            )?;
         }
         return Ok((written, warnings));
     }
@@ -340,7 +280,14 @@ fn write_outputs(
 
     let (w, h) = options.picture;
     if let Some(wet) = &sim.wet {
-        write_wet_outputs(wet, &sim.cloth_triangles, out, (w, h), &mut written, &mut warnings)?;
+        write_wet_outputs(
+            wet,
+            &sim.cloth_triangles,
+            out,
+            (w, h),
+            &mut written,
+            &mut warnings,
+        )?;
         return Ok((written, warnings));
     }
     let solid_final = solid_part
@@ -365,7 +312,14 @@ fn write_outputs(
     match &sim.chart {
         Some(chart) if crate::chart::DRAWN => {
             let size = (2 * w as u32, h as u32);
-            write_chart(out, outputs::PICTURE, chart, size, &mut written, &mut warnings)?;
+            write_chart(
+                out,
+                outputs::PICTURE,
+                chart,
+                size,
+                &mut written,
+                &mut warnings,
+            )?;
         }
         _ => {
             // Without the `charts` feature a virtual test's chart gives way to the cloth's picture.
@@ -419,7 +373,14 @@ fn write_wet_outputs(
     atelier_fabric::files::write_atomic(&path, wet.series_csv.as_bytes()).map_err(io(path))?;
     written.push(outputs::SERIES.into());
     for (name, chart) in &wet.charts {
-        write_chart(out, name, chart, (2 * w as u32, h as u32), written, warnings)?;
+        write_chart(
+            out,
+            name,
+            chart,
+            (2 * w as u32, h as u32),
+            written,
+            warnings,
+        )?;
     }
     Ok(())
 }
@@ -451,27 +412,6 @@ fn write_chart(
         ));
     }
     Ok(())
-}
-
-/// Check each expectation against the metrics.
-pub fn check_expectations(
-    scenario: &Scenario,
-    metrics: &BTreeMap<String, Option<f64>>,
-) -> Vec<ExpectationResult> {
-    scenario
-        .expectations
-        .iter()
-        .map(|e| {
-            let value = metrics.get(&e.metric).copied().flatten();
-            ExpectationResult {
-                metric: e.metric.clone(),
-                min: e.min,
-                max: e.max,
-                value,
-                met: e.met_by(value),
-            }
-        })
-        .collect()
 }
 
 /// Simulate a scenario (nothing is written). `base` resolves its relative paths.

@@ -15,7 +15,7 @@ use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
 use nalgebra::{DVector, Vector3};
 
-use crate::run::RunError;
+use crate::outcome::RunError;
 use crate::scenario::StripDirection;
 
 /// How the turned strip is run.

@@ -12,6 +12,8 @@
 //! or an expectation was not met — its report and outputs are written all the same. Errors are
 //! one line on stderr, never a backtrace.
 
+mod validate;
+
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -181,7 +183,7 @@ fn main() -> ExitCode {
             out,
             options,
         }) => {
-            let mut inputs = atelier::tryon::TryonInputs::new(photo, mask, garment);
+            let mut inputs = atelier_tryon::TryonInputs::new(photo, mask, garment);
             inputs.pose = pose;
             inputs.yaw_deg = yaw;
             inputs.height_cm = height;
@@ -278,7 +280,7 @@ fn parse_light(text: &str) -> Result<[f64; 3], String> {
     }
 }
 
-fn tryon(inputs: &atelier::tryon::TryonInputs, out: &Path, options: Options) -> ExitCode {
+fn tryon(inputs: &atelier_tryon::TryonInputs, out: &Path, options: Options) -> ExitCode {
     let run_options = match start(options) {
         Ok(o) => o,
         Err(code) => return code,
@@ -289,7 +291,7 @@ fn tryon(inputs: &atelier::tryon::TryonInputs, out: &Path, options: Options) -> 
             b.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
         }
     };
-    let result = atelier::tryon::tryon(inputs, out, &run_options, &mut progress);
+    let result = atelier_tryon::tryon(inputs, out, &run_options, &mut progress);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -386,12 +388,12 @@ fn progress_bar(name: &str) -> Option<indicatif::ProgressBar> {
 fn validate(files: &[PathBuf]) -> ExitCode {
     let mut failed = 0;
     for f in files {
-        let outcome = atelier::validate::validate(f);
+        let outcome = validate::validate(f);
         failed += usize::from(outcome.is_err());
         // The report is the program's output.
         #[allow(clippy::print_stdout)]
         {
-            println!("{}", atelier::validate::report_line(f, &outcome));
+            println!("{}", validate::report_line(f, &outcome));
         }
     }
     if failed > 0 {

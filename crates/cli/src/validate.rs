@@ -82,10 +82,10 @@ pub fn validate(path: &Path) -> Outcome {
     }
     // A file that reads as a scenario is one: its later checks (ranges, metric names, the
     // files it names) must not lose to another format's parse error.
-    if let Ok(s) = atelier_fabric::files::load_ron::<crate::scenario::Scenario>(path) {
-        return crate::scenario::Scenario::load(path)
+    if let Ok(s) = atelier_fabric::files::load_ron::<atelier::scenario::Scenario>(path) {
+        return atelier::scenario::Scenario::load(path)
             .and_then(|_| {
-                s.check_files(&crate::run::base_of(path))
+                s.check_files(&atelier::run::base_of(path))
                     .map_err(|e| FileError::from_invalid(path, e))
             })
             .map(|()| Kind::Scenario)
@@ -115,12 +115,12 @@ pub fn validate(path: &Path) -> Outcome {
             atelier_fabric::files::load_ron::<atelier_grid::range::SideFile>(p).map(|_| ())
         }),
         (Kind::TryonPose, &|p| {
-            let pose: crate::tryon::pose::PoseFile = atelier_fabric::files::load_ron(p)?;
+            let pose: atelier_tryon::pose::PoseFile = atelier_fabric::files::load_ron(p)?;
             pose.check().map_err(|e| FileError::from_invalid(p, e))
         }),
         (Kind::Scenario, &|p| {
-            let s = crate::scenario::Scenario::load(p)?;
-            s.check_files(&crate::run::base_of(p))
+            let s = atelier::scenario::Scenario::load(p)?;
+            s.check_files(&atelier::run::base_of(p))
                 .map_err(|e| FileError::from_invalid(p, e))
         }),
     ];

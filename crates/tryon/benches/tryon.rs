@@ -1,5 +1,5 @@
 //! Benchmarks of the virtual try-on (issue 11): the synthetic `arms_raised` photograph of
-//! `atelier::tryon::examples` (420 × 460 px, the person 380 px tall).
+//! `atelier_tryon::examples` (420 × 460 px, the person 380 px tall).
 //!
 //! - `tryon/fit`: the whole pose fit from the standard pose (limb search, then three levels of
 //!   Levenberg–Marquardt), as `atelier tryon` runs it.
@@ -17,13 +17,13 @@ use std::time::Duration;
 
 use atelier::run::simulate_scene;
 use atelier::scenario::{Scenario, ScenarioKind};
-use atelier::tryon::camera::coverage;
-use atelier::tryon::composite::composite;
-use atelier::tryon::examples::examples;
-use atelier::tryon::pose::{FitOptions, PoseFile, fit_pose, posed_mannequin, synthetic_photo};
-use atelier::tryon::posed_scene;
 use atelier_body::Mannequin;
 use atelier_body::build::jis_9ar_description;
+use atelier_tryon::camera::coverage;
+use atelier_tryon::composite::composite;
+use atelier_tryon::examples::examples;
+use atelier_tryon::pose::{FitOptions, PoseFile, fit_pose, posed_mannequin, synthetic_photo};
+use atelier_tryon::posed_scene;
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn tryon(c: &mut Criterion) {
@@ -73,7 +73,7 @@ fn tryon(c: &mut Criterion) {
                 (&cloth, &sim.cloth_triangles),
                 (&body, &solid.triangles),
                 atelier::picture::CLOTH,
-                atelier::tryon::DEFAULT_LIGHT,
+                atelier_tryon::DEFAULT_LIGHT,
             ))
         })
     });

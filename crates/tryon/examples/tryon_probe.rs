@@ -1,13 +1,13 @@
 //! Probe (not a test): the try-on's garment run for one of the synthetic examples, with the
 //! example's true pose and sizes instead of the fit: a line per step (time, iterations,
 //! factorisations, convergence, wall time), to see where the try-on's time goes:
-//! `cargo run --release -p atelier --example tryon_probe -- [arms_raised|standing|mid_stride] [GARMENT.ron] [seconds]`
+//! `cargo run --release -p atelier-tryon --example tryon_probe -- [arms_raised|standing|mid_stride] [GARMENT.ron] [seconds]`
 //! (`PROBE_9AR=1`: the 9AR mannequin's sizes instead of the example person's).
 use atelier::Simulation;
 use atelier::scenario::{Scenario, ScenarioKind};
-use atelier::tryon::{HOLD_S, examples::examples, posed_scene};
 use atelier_body::Mannequin;
 use atelier_body::build::{Sizes, jis_9ar_description};
+use atelier_tryon::{HOLD_S, examples::examples, posed_scene};
 use std::path::Path;
 
 fn main() {

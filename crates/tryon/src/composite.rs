@@ -7,7 +7,7 @@
 
 use super::camera::Camera;
 use super::image::{Mask, Photo};
-use crate::picture::{MeshRef, rasterise, triangle_shade};
+use atelier::picture::{MeshRef, rasterise, triangle_shade};
 
 /// A composite and where the garment is.
 #[derive(Clone, Debug)]

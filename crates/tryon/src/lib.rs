@@ -13,25 +13,21 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use atelier_body::build::{Sizes, jis_9ar_description};
+use atelier_body::build::jis_9ar_description;
 use atelier_body::description::BodyDescription;
 use atelier_body::motion::{KeyframeSpec, LimitPolicy, MotionSpec};
 use atelier_body::{Mannequin, Motion};
 use atelier_fabric::FileError;
-use serde::{Deserialize, Serialize};
 
-use crate::report::Report;
-use crate::run::{
+use atelier::report::Report;
+pub use atelier::report::{LOW_IOU, TryonInfo};
+use atelier::run::{
     RunError, RunOptions, base_of, outputs, prepare_folder, simulate_scene, write_run,
 };
-use crate::scenario::{Scenario, ScenarioKind};
-use crate::scene::{Garment, GarmentSpec, Scene};
-use camera::Camera;
+use atelier::scenario::{Scenario, ScenarioKind};
+use atelier::scene::{Garment, GarmentSpec, Scene};
 use image::{Mask, Photo};
 use pose::{FitOptions, PoseFile, PoseFit};
-
-/// Below this overlap the fit is reported as failed (a warning and exit status 2).
-pub const LOW_IOU: f64 = 0.8;
 
 /// How fast the mannequin turns from the standard pose to the fitted one, degrees per second
 /// (the largest joint's turn sets the motion's length; at least [`MIN_MOTION_S`]).
@@ -76,7 +72,7 @@ impl TryonInputs {
             yaw_deg: 0.0,
             height_cm: None,
             light: DEFAULT_LIGHT,
-            colour: crate::picture::CLOTH,
+            colour: atelier::picture::CLOTH,
             threshold: 40,
         }
     }
@@ -84,45 +80,6 @@ impl TryonInputs {
 
 /// The default light: from the front, above, and the body's left.
 pub const DEFAULT_LIGHT: [f64; 3] = [0.4, 0.6, 1.0];
-
-/// The try-on's part of `report.json`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TryonInfo {
-    /// The photograph, as given.
-    pub photo: String,
-    /// The mask, as given; `null` when the background was segmented.
-    pub mask: Option<String>,
-    /// Pixels of the person in the mask.
-    pub mask_pixels: usize,
-    /// Silhouette overlap (intersection over union) at the start: the standard (or given)
-    /// pose, the camera put on the mask's box.
-    pub iou_before: f64,
-    /// Silhouette overlap fitted.
-    pub iou_after: f64,
-    /// Wall time of the fit, s.
-    pub fit_s: f64,
-    /// Silhouettes rendered by the fit.
-    pub evaluations: usize,
-    /// How the fit's last minimisation ended.
-    pub termination: String,
-    /// The fitted camera.
-    pub camera: Camera,
-    /// The fitted sizes.
-    pub sizes: Sizes,
-    /// Fitted joint angles (α, β, γ), degrees, by part.
-    pub joints: BTreeMap<String, (f64, f64, f64)>,
-    /// Length of the motion from the standard pose to the fitted one, s.
-    pub motion_s: f64,
-    /// Pixels of the person the fitted mannequin does not cover (red in `overlay.png`): where
-    /// the person is wider than the mannequin, the person can show beside the garment (the
-    /// composite does not paint the photograph's background over them).
-    pub person_outside_mannequin_px: usize,
-    /// Pixels of the photograph the garment covers.
-    pub garment_pixels: usize,
-    /// The light's direction (body frame).
-    pub light: [f64; 3],
-}
 
 /// Why a try-on could not run.
 #[derive(Debug, thiserror::Error)]

@@ -647,11 +647,11 @@ pub fn synthetic_photo(
     const SKIN: [f64; 3] = [0.87, 0.67, 0.55];
     const BACKGROUND: [u8; 3] = [214, 222, 230];
     let light = camera.view_direction([0.3, 0.5, 1.0]);
-    let pixels = crate::picture::render_lit(
+    let pixels = atelier::picture::render_lit(
         &view,
         &triangles,
         &|_| SKIN,
-        crate::picture::View::Front,
+        atelier::picture::View::Front,
         camera.fit(w, h, 1),
         (w, h),
         Some(light),
@@ -659,7 +659,7 @@ pub fn synthetic_photo(
     let mut data = Vec::with_capacity(3 * w * h);
     let mut mask = Vec::with_capacity(w * h);
     for p in &pixels {
-        data.extend_from_slice(&p.map_or(BACKGROUND, crate::picture::to_bytes));
+        data.extend_from_slice(&p.map_or(BACKGROUND, atelier::picture::to_bytes));
         mask.push(p.is_some());
     }
     Ok((

@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use atelier::run::RunOptions;
-use atelier::tryon::examples::{Example, examples};
-use atelier::tryon::image::{Mask, Photo, encode, load_photo, segment_plain_background};
-use atelier::tryon::pose::{FITTED, FitOptions, PoseFile, fit_pose, synthetic_photo};
-use atelier::tryon::{TryonError, TryonInputs, fit_warnings, load_inputs, tryon};
 use atelier_body::build::jis_9ar_description;
+use atelier_tryon::examples::{Example, examples};
+use atelier_tryon::image::{Mask, Photo, encode, load_photo, segment_plain_background};
+use atelier_tryon::pose::{FITTED, FitOptions, PoseFile, fit_pose, synthetic_photo};
+use atelier_tryon::{TryonError, TryonInputs, fit_warnings, load_inputs, tryon};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")

@@ -23,6 +23,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::scene::GarmentSpec;
 
+pub mod string_fit;
+pub mod wet;
+
 /// One scenario file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -61,10 +64,10 @@ pub enum ScenarioKind {
     KesBending(KesBendingSpec),
     /// Yamada's wet cloth: a square on a plane, pinched and lifted over trapped air
     /// ([`crate::wet`]), on one solver and optionally compared with another.
-    Wet(crate::wet::WetSpec),
+    Wet(wet::WetSpec),
     /// Sudoh et al.'s string identification ([`crate::fit`]): J observed shapes fitted,
     /// reproduced, and the later shapes predicted.
-    StringFit(crate::fit::StringFitSpec),
+    StringFit(string_fit::StringFitSpec),
 }
 
 impl ScenarioKind {
@@ -101,8 +104,8 @@ impl ScenarioKind {
     /// `unconverged_fraction` (`null` when its solver does not report convergence).
     pub fn metric_names(&self) -> &'static [&'static str] {
         match self {
-            ScenarioKind::Wet(_) => crate::wet::METRICS,
-            ScenarioKind::StringFit(_) => crate::fit::METRICS,
+            ScenarioKind::Wet(_) => wet::METRICS,
+            ScenarioKind::StringFit(_) => string_fit::METRICS,
             ScenarioKind::Garment(_) => &[
                 "nodes",
                 "cloth_triangles",
@@ -455,8 +458,8 @@ impl Scenario {
             .map(|f| ("kind.fabric", f))
             .into_iter()
             .collect();
-        if let ScenarioKind::StringFit(crate::fit::StringFitSpec {
-            observations: crate::fit::Source::File(f),
+        if let ScenarioKind::StringFit(string_fit::StringFitSpec {
+            observations: string_fit::Source::File(f),
             ..
         }) = &self.kind
         {

@@ -158,7 +158,7 @@ pub const CLOTH: &str = r#"ClothObservations(
 
 /// A try-on start pose (`--pose`, the format of `fitted_pose.ron`): parse and check.
 pub fn load_pose(text: String) {
-    if let Ok(pose) = atelier_fabric::files::parse_ron::<atelier::tryon::pose::PoseFile>(
+    if let Ok(pose) = atelier_fabric::files::parse_ron::<atelier_tryon::pose::PoseFile>(
         &text,
         Path::new("hostile_pose.ron"),
     ) {
@@ -172,11 +172,11 @@ pub fn load_picture(bytes: Vec<u8>) {
     let dir = scratch("picture");
     let path = dir.join("p.png");
     std::fs::write(&path, &bytes).expect("write");
-    if let Ok(photo) = atelier::tryon::image::load_photo(&path) {
-        let _ = atelier::tryon::image::load_mask(&path, (photo.width, photo.height));
-        let _ = atelier::tryon::image::load_mask(&path, (photo.width + 1, photo.height));
+    if let Ok(photo) = atelier_tryon::image::load_photo(&path) {
+        let _ = atelier_tryon::image::load_mask(&path, (photo.width, photo.height));
+        let _ = atelier_tryon::image::load_mask(&path, (photo.width + 1, photo.height));
         if photo.width * photo.height <= 1 << 20 {
-            let _ = atelier::tryon::image::segment_plain_background(&photo, 40);
+            let _ = atelier_tryon::image::segment_plain_background(&photo, 40);
         }
     }
     std::fs::remove_dir_all(&dir).ok();

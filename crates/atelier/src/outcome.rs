@@ -1,0 +1,139 @@
+//! What a simulation produced, before anything is written ([`Simulated`]), and why a run could
+//! not start or write ([`RunError`]): the data the runner ([`crate::run`]), the report
+//! ([`crate::report`]) and the scene kinds ([`crate::wet`], [`crate::fit`]) share. It holds
+//! data only, so every one of them can depend on it without depending on each other.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::chart::Chart;
+use crate::convergence::Convergence;
+use crate::export::Animation;
+use crate::simulation::Timings;
+
+/// Why a scenario could not be run or its outputs not written. (A run that diverges is not an
+/// error: it is a [`Simulated`] with a failure, and its outputs are written.)
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scene could not be set up (a file it names, a parameter out of range).
+    #[error("{0}")]
+    Setup(String),
+    /// The output folder could not be created or written.
+    #[error("cannot write {}: {source}", path.display())]
+    Output {
+        /// The folder or file.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// A fixed part drawn and exported with the cloth: the body, or a drape tester's support.
+#[derive(Clone, Debug)]
+pub struct Solid {
+    /// Part name in the exports (`body`, `support`, `platform`).
+    pub name: &'static str,
+    /// Triangles (vertex indices), outward.
+    pub triangles: Vec<[u32; 3]>,
+    /// Its positions over the run (one frame when it does not move).
+    pub motion: Animation,
+}
+
+/// What a simulation produced, before anything is written.
+#[derive(Clone, Debug)]
+pub struct Simulated {
+    /// The fabric's name.
+    pub fabric: String,
+    /// Cloth triangles (node indices).
+    pub cloth_triangles: Vec<[u32; 3]>,
+    /// Cloth node positions over the run (y up), the last frame the final or last good state.
+    pub cloth: Animation,
+    /// The body or the tester, if any.
+    pub solid: Option<Solid>,
+    /// Steps taken.
+    pub steps: usize,
+    /// Time step, s.
+    pub dt: f64,
+    /// Simulated time reached, s.
+    pub simulated: f64,
+    /// Wall time of the steps, s.
+    pub wall_seconds: f64,
+    /// Wall time per stage, summed over the steps.
+    pub timings: Timings,
+    /// Metrics by name (see [`ScenarioKind::metric_names`]); `None` when not measured (for
+    /// example a drape coefficient after a failed step).
+    pub metrics: BTreeMap<String, Option<f64>>,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+    /// The failure that ended the run early.
+    pub failure: Option<String>,
+    /// A chart drawn instead of the final state's views (the virtual KES tests: the loop).
+    pub chart: Option<Chart>,
+    /// The series, charts and second run of a wet scene.
+    pub wet: Option<Box<WetOutputs>>,
+    /// The fitted parameters of a string identification.
+    pub fit: Option<Box<FitOutputs>>,
+    /// The compared run of a wet scene.
+    pub comparison: Option<Comparison>,
+    /// Whether the steps converged (`None`: no solver stepped, the string identification).
+    pub convergence: Option<Convergence>,
+}
+
+/// What a wet run adds to the usual outputs: the series, charts and the compared run's final
+/// state.
+#[derive(Clone, Debug)]
+pub struct WetOutputs {
+    /// `series.csv`: one row per sample of each run.
+    pub series_csv: String,
+    /// Charts by file name (`tent.png`, `pressure.png`).
+    pub charts: Vec<(&'static str, Chart)>,
+    /// Final positions of the main run, z up (for its picture).
+    pub final_z_up: Vec<[f64; 3]>,
+    /// Final positions of the compared run, z up.
+    pub compare_z_up: Option<Vec<[f64; 3]>>,
+    /// Side of the square cloth, m.
+    pub size: f64,
+}
+
+/// What a string-fit run adds: the fitted parameters.
+#[derive(Clone, Debug)]
+pub struct FitOutputs {
+    /// `parameters.ron`: the fitted model.
+    pub parameters_ron: String,
+}
+
+/// A second run of the same scene on another solver (wet scenes), with its cost (its metrics
+/// are the report's `compare_*` metrics).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Comparison {
+    /// `yamada` or `party`.
+    pub solver: String,
+    /// Its time step, s.
+    pub dt_s: f64,
+    /// Steps taken.
+    pub steps: usize,
+    /// Simulated time reached, s.
+    pub simulated_s: f64,
+    /// Wall time of its steps, s.
+    pub wall_s: f64,
+    /// Of which the pressure force, s.
+    pub pressure_s: f64,
+    /// The failure that ended it early (`null`: none).
+    pub failure: Option<String>,
+    /// Whether its steps converged (its counts `null` when its solver does not report it).
+    #[serde(default)]
+    pub convergence: Option<Convergence>,
+}
+
+impl Comparison {
+    /// The warning about the compared run's unconverged steps (`the compared party run: …`),
+    /// if some step did not converge.
+    pub fn convergence_warning(&self) -> Option<String> {
+        let w = self.convergence.as_ref().and_then(Convergence::warning)?;
+        Some(format!("the compared {} run: {w}", self.solver))
+    }
+}
