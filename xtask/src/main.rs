@@ -28,6 +28,9 @@
 //! - `cargo xtask knob-table [--check]` — the table of `StepParams`' knobs in `docs/solver.md`
 //!   regenerated from `StepParams::default()` and the doc comments of `params.rs`; `--check`
 //!   fails if the file is out of date (so does `cargo test --workspace`).
+//! - `cargo xtask check-layout` — no import cycle between the top-level modules of any crate,
+//!   no source file over 800 lines without a `//! Length:` line saying why (the same check is a
+//!   test, so `cargo test --workspace` runs it).
 //! - `cargo xtask run-scenarios [--only NAME…] [--skip NAME…] [--out DIR] [--shard I/N]` —
 //!   every scenario of `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on
 //!   a full run (or one with only `--skip`) `docs/results.md` with its gallery; fails if a
@@ -46,6 +49,7 @@ mod figures_tradeoff;
 mod figures_tryon;
 mod figures_wet;
 mod knob_table;
+mod layout;
 mod plot;
 mod run_scenarios;
 
@@ -107,6 +111,9 @@ enum Command {
         #[arg(long)]
         check: bool,
     },
+    /// Check the layout rules: no import cycle between a crate's modules, no source file over
+    /// 800 lines without a `//! Length:` line saying why (also run by `cargo test`).
+    CheckLayout,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -200,6 +207,7 @@ fn main() -> Result<()> {
                 std::process::exit(1);
             }
         }
+        Command::CheckLayout => layout::main(&repository_root())?,
     }
     Ok(())
 }
