@@ -37,20 +37,9 @@
 //!   scenario fails or misses an expectation.
 
 mod bench_report;
-mod figures_body;
-mod figures_dress;
-mod figures_fabric;
-mod figures_fit;
-mod figures_grid;
-mod figures_grid_body;
-mod figures_solver;
-mod figures_stability;
-mod figures_tradeoff;
-mod figures_tryon;
-mod figures_wet;
+mod figures;
 mod knob_table;
 mod layout;
-mod plot;
 mod run_scenarios;
 
 use std::path::{Path, PathBuf};
@@ -159,20 +148,20 @@ fn main() -> Result<()> {
     match cli.command {
         Command::Figures { which, out } => {
             let (name, draw_all): (&str, DrawAll) = match which {
-                FigureSet::Fabric => ("fabric", figures_fabric::draw_all),
-                FigureSet::Solver => ("solver", figures_solver::draw_all),
-                FigureSet::Grid => ("grid", figures_grid::draw_all),
-                FigureSet::Body => ("body", figures_body::draw_all),
-                FigureSet::Wet => ("wet", figures_wet::draw_all),
-                FigureSet::Fit => ("fit", figures_fit::draw_all),
-                FigureSet::Stability => ("stability", figures_stability::draw_all),
-                FigureSet::Tradeoff => ("tradeoff", figures_tradeoff::draw_all),
-                FigureSet::Tryon => ("tryon", figures_tryon::draw_all),
-                FigureSet::Dress => ("dress", figures_dress::draw_all),
+                FigureSet::Fabric => ("fabric", figures::fabric::draw_all),
+                FigureSet::Solver => ("solver", figures::solver::draw_all),
+                FigureSet::Grid => ("grid", figures::grid::draw_all),
+                FigureSet::Body => ("body", figures::body::draw_all),
+                FigureSet::Wet => ("wet", figures::wet::draw_all),
+                FigureSet::Fit => ("fit", figures::fit::draw_all),
+                FigureSet::Stability => ("stability", figures::stability::draw_all),
+                FigureSet::Tradeoff => ("tradeoff", figures::tradeoff::draw_all),
+                FigureSet::Tryon => ("tryon", figures::tryon::draw_all),
+                FigureSet::Dress => ("dress", figures::dress::draw_all),
             };
             let out = out.unwrap_or_else(|| repository_root().join("figures").join(name));
             std::fs::create_dir_all(&out)?;
-            plot::register_font()?;
+            figures::plot::register_font()?;
             for written in draw_all(&repository_root(), &out)? {
                 eprintln!("wrote {}", written.display());
             }

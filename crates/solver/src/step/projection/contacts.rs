@@ -1,8 +1,8 @@
 //! The contact planes inside the shape solve: the active set updated, entering nodes held,
 //! the velocities projected onto the planes.
 
-use super::super::plane_push;
 use super::{ON_PLANE, ShapeProblem, ShapeSolver, V3};
+use crate::step::plane_push;
 
 impl ShapeSolver {
     /// The contact planes in the Newton system: a node that lies on its plane (pushed there by

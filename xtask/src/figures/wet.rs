@@ -29,7 +29,7 @@ use atelier_solver::wet::scene::{
 };
 use plotters::prelude::*;
 
-use crate::plot::{PALETTE, png};
+use crate::figures::plot::{PALETTE, png};
 
 /// The thesis's Table 4.2: particles, frames per second (Core i7-3930K, one thread).
 const THESIS_FPS: [(usize, f64); 5] = [

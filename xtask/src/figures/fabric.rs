@@ -12,7 +12,7 @@ use atelier_fabric::{
 };
 use plotters::prelude::*;
 
-use crate::plot::{PALETTE, nice_ceiling, png, polar_axes, polar_points};
+use crate::figures::plot::{PALETTE, nice_ceiling, png, polar_axes, polar_points};
 
 const FIXTURES: [&str; 6] = [
     "cotton_broad",

@@ -9,10 +9,10 @@ use atelier_grid::range::synthetic::Mannequin;
 use atelier_grid::range::{BodyGridParams, BodyMesh, ErrorImage, Part, grid_body, measure_error};
 use plotters::prelude::*;
 
-use crate::plot::{blit, png};
+use crate::figures::plot::{blit, png};
 use atelier::picture::{Fit, View, part_colour, render, screen_box};
 
-use crate::plot::to_rgb;
+use crate::figures::plot::to_rgb;
 
 /// Draw the body figures into `out`.
 pub fn draw_all(out: &Path) -> Result<Vec<PathBuf>> {

@@ -15,7 +15,7 @@ use atelier_solver::metrics::{HEM_BAND, hem_extent};
 use plotters::prelude::*;
 use rayon::prelude::*;
 
-use crate::plot::{blit, png};
+use crate::figures::plot::{blit, png};
 
 /// The fabrics, by fixture file, in the order drawn.
 const FABRICS: [&str; 3] = ["silk", "cotton_broad", "denim"];

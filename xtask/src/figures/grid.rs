@@ -11,7 +11,7 @@ use atelier_grid::{ImproveParams, Patch};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::plot::{PALETTE, png};
+use crate::figures::plot::{PALETTE, png};
 
 /// Draw every grid figure into `out`; returns the files written.
 pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
@@ -32,7 +32,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
         dress_panels(&dress, &out.join("grid_dress_panels.png"))?,
         before_after(&hill, &out.join("grid_depth.png"))?,
     ];
-    written.extend(crate::figures_grid_body::draw_all(out)?);
+    written.extend(crate::figures::grid_body::draw_all(out)?);
     Ok(written)
 }
 

@@ -24,7 +24,7 @@ use nalgebra::Vector3;
 use plotters::prelude::*;
 use rayon::prelude::*;
 
-use crate::plot::png;
+use crate::figures::plot::png;
 
 const SOLVERS: [&str; 3] = ["PARTY", "mass-spring", "XPBD"];
 const FABRICS: [&str; 4] = ["silk", "polyester_faille", "cotton_broad", "denim"];
@@ -185,7 +185,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
             .expect("every case ran")
     };
     let mut md = String::from(
-        "# Stability map\n\nWritten by `cargo xtask figures stability` (see `xtask/src/figures_stability.rs` for the scene). Each cell: the outcome and the largest axial strain seen (%).\n",
+        "# Stability map\n\nWritten by `cargo xtask figures stability` (see `xtask/src/figures/stability.rs` for the scene). Each cell: the outcome and the largest axial strain seen (%).\n",
     );
     for (s, name) in SOLVERS.iter().enumerate() {
         let _ = write!(md, "\n## {name}\n\n| fabric | body speed, m/s |");

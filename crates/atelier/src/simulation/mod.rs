@@ -21,19 +21,23 @@ use std::time::{Duration, Instant};
 
 use atelier_body::kinematics::Posed;
 use atelier_body::model::LabelledMesh;
-use atelier_body::motion::PoseRate;
 use atelier_collide::parts::Motion as PartMotion;
 use atelier_collide::{ContactMaterial, ContactParams, RigidParts, V3};
 use atelier_solver::baselines::{BaselineReport, MassSpring, MassSpringParams, Xpbd, XpbdParams};
 use atelier_solver::{
     BodyContact, ClothState, Solver, StageTimings, StepError, StepParams, StepReport,
 };
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::place::place;
 use crate::scene::{ClothSolver, Dressing, Scene, SceneError};
 use crate::{Chain, Sewing};
+
+use diagnostics::{open_seams, penetration};
+use setup::{exposed_triangles, part_motions, seam_groups};
+
+mod diagnostics;
+mod setup;
 
 /// The phase of the dressing schedule a step belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -692,139 +696,4 @@ impl Simulation {
             .collect::<Vec<_>>()
             .join(", ")
     }
-}
-
-/// Nodes inside the body at the end of the step and the deepest depth, m. A node whose
-/// distance at the start of the step (`start_distance`, or a lower bound) exceeds how far it
-/// moved plus how far any body point moved cannot be inside (the distance is 1-Lipschitz) and
-/// is not queried.
-fn penetration(
-    nodes: &[V3],
-    start: &[V3],
-    start_distance: &[f64],
-    parts: &RigidParts,
-) -> (usize, f64) {
-    let body_moved = parts.max_displacement();
-    nodes
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| {
-            if let (Some(d0), Some(x0)) = (start_distance.get(i), start.get(i))
-                && *d0 - (p - x0).norm() - body_moved > 0.0
-            {
-                return (0, 0.0);
-            }
-            match parts.nearest(p, 0.0, true) {
-                Some(n) if n.distance < 0.0 => (1, -n.distance),
-                _ => (0, 0.0),
-            }
-        })
-        .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
-}
-
-/// For every node, the smallest node it is joined to through seam pairs (itself when none).
-fn seam_groups(n: usize, pairs: &[(u32, u32)]) -> Vec<u32> {
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn root(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            parent[x as usize] = parent[parent[x as usize] as usize];
-            x = parent[x as usize];
-        }
-        x
-    }
-    for &(a, b) in pairs {
-        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-        let (lo, hi) = (ra.min(rb), ra.max(rb));
-        parent[hi as usize] = lo;
-    }
-    (0..n as u32).map(|i| root(&mut parent, i)).collect()
-}
-
-/// The rigid motion of every part (rest → world) in a pose, in the mannequin's part order.
-fn part_motions(body: &atelier_body::kinematics::Body, rate: &PoseRate, out: &mut [PartMotion]) {
-    let frames = body.frames(rate);
-    for (m, part) in out.iter_mut().zip(&body.mannequin.parts) {
-        let f = frames[part.part.index()];
-        let r = f.rotation;
-        *m = PartMotion::from_parts((f.pivot - r * part.pivot).into(), r);
-    }
-}
-
-/// The body triangles not buried in another part: a triangle whose three vertices are all more
-/// than 1 mm inside some other part is left out of the continuous test.
-fn exposed_triangles(
-    mannequin: &atelier_body::model::Mannequin,
-    rest: &LabelledMesh,
-    parts: &RigidParts,
-) -> Vec<[u32; 3]> {
-    // Part k of `parts` is `mannequin.parts[k]`.
-    let index_of = |part: atelier_body::model::Part| {
-        mannequin
-            .parts
-            .iter()
-            .position(|p| p.part == part)
-            .expect("every labelled part is a mannequin part")
-    };
-    // Whether each vertex lies more than 1 mm inside a part other than its own (once per
-    // vertex, in parallel: a vertex is shared by about six triangles).
-    let buried: Vec<bool> = (0..rest.vertices.len())
-        .into_par_iter()
-        .map(|v| {
-            let (p, own) = (rest.vertices[v], index_of(rest.vertex_part[v]));
-            (0..parts.len())
-                .filter(|&k| k != own)
-                .any(|k| parts.rest_distance(k, &p) < -1e-3)
-        })
-        .collect();
-    rest.triangles
-        .iter()
-        .filter(|t| !t.iter().all(|&v| buried[v as usize]))
-        .copied()
-        .collect()
-}
-
-/// The seams with open pairs: name, open pairs of all, the widest gap and where it is.
-fn open_seams(sewing: &Sewing, g: &crate::GarmentCloth, positions: &[V3]) -> String {
-    // (name, open, all, widest gap, its midpoint)
-    let mut seams: Vec<(&str, usize, usize, f64, V3)> = Vec::new();
-    let open = sewing.unsewn();
-    for (k, name) in g.pair_names.iter().enumerate() {
-        let idx = match seams.iter().position(|s| s.0 == name) {
-            Some(i) => i,
-            None => {
-                seams.push((name, 0, 0, 0.0, V3::zeros()));
-                seams.len() - 1
-            }
-        };
-        let seam = &mut seams[idx];
-        seam.2 += 1;
-        if open.binary_search(&k).is_ok() {
-            let (a, b) = (
-                positions[g.pairs[k].0 as usize],
-                positions[g.pairs[k].1 as usize],
-            );
-            seam.1 += 1;
-            if (a - b).norm() >= seam.3 {
-                seam.3 = (a - b).norm();
-                seam.4 = (a + b) * 0.5;
-            }
-        }
-    }
-    seams
-        .iter()
-        .filter(|s| s.1 > 0)
-        .map(|s| {
-            format!(
-                "{} ({} of {}, widest {:.1} mm at ({:.3}, {:.3}, {:.3}) m)",
-                s.0,
-                s.1,
-                s.2,
-                s.3 * 1e3,
-                s.4.x,
-                s.4.y,
-                s.4.z
-            )
-        })
-        .collect::<Vec<_>>()
-        .join(", ")
 }

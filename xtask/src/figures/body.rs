@@ -8,10 +8,10 @@ use atelier_body::range::{RenderParams, render_views};
 use atelier_body::{Body, LabelledMesh, Motion};
 use plotters::prelude::*;
 
-use crate::plot::{blit, png};
+use crate::figures::plot::{blit, png};
 use atelier::picture::{Fit, View, part_colour, render, screen_box};
 
-use crate::plot::to_rgb;
+use crate::figures::plot::to_rgb;
 
 /// Draw the body figures into `out`; returns the files written.
 pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {

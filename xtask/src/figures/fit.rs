@@ -21,7 +21,7 @@ use atelier_fit::synthetic::{Object, SyntheticOptions, observe};
 use atelier_fit::{FitOptions, StringModel};
 use plotters::prelude::*;
 
-use crate::plot::{PALETTE, png};
+use crate::figures::plot::{PALETTE, png};
 
 /// Observed markers and a reproduced shape, image pixels.
 type ShapePair = (Vec<[f64; 2]>, Vec<[f64; 2]>);

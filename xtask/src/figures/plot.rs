@@ -9,7 +9,7 @@ use plotters::prelude::*;
 
 /// Register DejaVu Sans (shipped in `assets/fonts`, see its licence there) as "sans-serif".
 pub fn register_font() -> Result<()> {
-    static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+    static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| anyhow!("the bundled font could not be loaded"))
 }

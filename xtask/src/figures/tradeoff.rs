@@ -32,7 +32,7 @@ use atelier_solver::{StepParams, TolerancePolicy};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::plot::{PALETTE, png};
+use crate::figures::plot::{PALETTE, png};
 
 /// Simulated time of the dress scene, s.
 const DRESS_T: f64 = 0.8;
@@ -364,7 +364,7 @@ pub fn run(out: &Path, quick: bool) -> Result<()> {
                 pareto: false,
             });
         }
-        let front = crate::plot::pareto_front(
+        let front = crate::figures::plot::pareto_front(
             &rows
                 .iter()
                 .map(|r| (r.outcome.wall.as_secs_f64(), r.error))
