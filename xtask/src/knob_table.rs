@@ -536,7 +536,7 @@ pub fn run(root: &Path, check: bool) -> Result<bool> {
         return Ok(expected == actual);
     }
     if expected != actual {
-        atelier_fabric::files::write_atomic(&root.join(DOC), expected.as_bytes())?;
+        atelier_files::files::write_atomic(&root.join(DOC), expected.as_bytes())?;
     }
     Ok(true)
 }

@@ -151,8 +151,8 @@ pub fn run_all(
         rows,
     };
     let json = serde_json::to_string_pretty(&summary)? + "\n";
-    atelier_fabric::files::write_atomic(&out.join("summary.json"), json.as_bytes())?;
-    atelier_fabric::files::write_atomic(
+    atelier_files::files::write_atomic(&out.join("summary.json"), json.as_bytes())?;
+    atelier_files::files::write_atomic(
         &out.join("summary.md"),
         summary_markdown(&summary, None).as_bytes(),
     )?;
@@ -482,7 +482,7 @@ fn write_results(root: &Path, out: &Path, s: &Summary, revision: &str) -> Result
         {
             let bytes =
                 std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
-            atelier_fabric::files::write_atomic(&img.join(format!("{}.png", r.name)), &bytes)?;
+            atelier_files::files::write_atomic(&img.join(format!("{}.png", r.name)), &bytes)?;
         }
         if r.report
             .as_ref()
@@ -491,7 +491,7 @@ fn write_results(root: &Path, out: &Path, s: &Summary, revision: &str) -> Result
             let from = out.join(&r.name).join("top.png");
             let bytes =
                 std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
-            atelier_fabric::files::write_atomic(&img.join(format!("{}-top.png", r.name)), &bytes)?;
+            atelier_files::files::write_atomic(&img.join(format!("{}-top.png", r.name)), &bytes)?;
         }
     }
     let mut md = String::from(
@@ -504,6 +504,6 @@ fn write_results(root: &Path, out: &Path, s: &Summary, revision: &str) -> Result
     );
     let _ = writeln!(md, "Run at commit {revision}.\n");
     md.push_str(&summary_markdown(s, Some("img/results")));
-    atelier_fabric::files::write_atomic(&root.join("docs/results.md"), md.as_bytes())?;
+    atelier_files::files::write_atomic(&root.join("docs/results.md"), md.as_bytes())?;
     Ok(())
 }

@@ -67,7 +67,7 @@ pub fn write_chart(path: &Path, chart: &Chart, size: (u32, u32)) -> std::io::Res
             "the bundled font could not be loaded",
         ));
     }
-    let tmp = atelier_fabric::files::temporary_sibling(path);
+    let tmp = atelier_files::files::temporary_sibling(path);
     let drawn = draw(&tmp, chart, size);
     match drawn {
         Ok(()) => std::fs::rename(&tmp, path),

@@ -228,7 +228,7 @@ pub fn write_png(
             .write_image_data(&data)
             .map_err(std::io::Error::other)?;
     }
-    atelier_fabric::files::write_atomic(path, &bytes)
+    atelier_files::files::write_atomic(path, &bytes)
 }
 
 /// One colour per body part index (hues spread by the golden ratio).

@@ -201,7 +201,7 @@ impl Report {
 
     /// Write the report atomically.
     pub fn write(&self, path: &Path) -> Result<(), RunError> {
-        atelier_fabric::files::write_atomic(path, self.to_json().as_bytes()).map_err(|source| {
+        atelier_files::files::write_atomic(path, self.to_json().as_bytes()).map_err(|source| {
             RunError::Output {
                 path: path.to_path_buf(),
                 source,

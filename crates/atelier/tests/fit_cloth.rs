@@ -9,7 +9,7 @@ use atelier::scenario::Scenario;
 use atelier::scenario::StripDirection;
 use atelier::strip::{TurnedRun, turned_strip};
 use atelier_fabric::Fabric;
-use atelier_fabric::noise::Rng;
+use atelier_files::noise::Rng;
 use atelier_fit::cloth::{ProfilePoint, fit_cantilever};
 use atelier_fit::turned::{TurnedProfile, fit_turned};
 

@@ -20,8 +20,8 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use atelier_fabric::check::Validate;
-use atelier_fabric::{ErrorKind, InvalidValue};
+use atelier_files::check::Validate;
+use atelier_files::{ErrorKind, InvalidValue};
 
 pub use crate::description::Sizes;
 use crate::description::{BodyDescription, PartDescription};

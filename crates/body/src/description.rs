@@ -7,8 +7,8 @@
 
 use std::path::Path;
 
-use atelier_fabric::check::{Validate, non_empty, positive};
-use atelier_fabric::{ErrorKind, FileError, InvalidValue};
+use atelier_files::check::{Validate, non_empty, positive};
+use atelier_files::{ErrorKind, FileError, InvalidValue};
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -70,7 +70,7 @@ impl Sizes {
             ("waist_cm", self.waist_cm),
             ("hip_cm", self.hip_cm),
         ] {
-            atelier_fabric::check::positive_value(v).map_err(|e| e.within(name))?;
+            atelier_files::check::positive_value(v).map_err(|e| e.within(name))?;
         }
         Ok(())
     }
@@ -106,7 +106,7 @@ impl Validate for Levels {
         Ok(())
     }
 }
-atelier_fabric::validated!(Levels);
+atelier_files::validated!(Levels);
 
 /// Mesh resolution.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -199,7 +199,7 @@ impl Validate for Limits {
         Ok(())
     }
 }
-atelier_fabric::validated!(Limits);
+atelier_files::validated!(Limits);
 
 impl Limits {
     /// As the model's joint limits.
@@ -343,7 +343,7 @@ impl Validate for PartDescription {
         Ok(())
     }
 }
-atelier_fabric::validated!(PartDescription);
+atelier_files::validated!(PartDescription);
 
 impl Validate for BodyDescription {
     fn validate(&self) -> Result<(), InvalidValue> {
@@ -384,17 +384,17 @@ impl Validate for BodyDescription {
         Ok(())
     }
 }
-atelier_fabric::validated!(BodyDescription);
+atelier_files::validated!(BodyDescription);
 
 impl BodyDescription {
     /// Parse RON text; `file` names the source in errors.
     pub fn parse(text: &str, file: &Path) -> Result<Self, FileError> {
-        atelier_fabric::files::parse_ron(text, file)
+        atelier_files::files::parse_ron(text, file)
     }
 
     /// Read and parse a description file.
     pub fn load(path: &Path) -> Result<Self, FileError> {
-        atelier_fabric::files::load_ron(path)
+        atelier_files::files::load_ron(path)
     }
 
     /// The description of a part, if listed.

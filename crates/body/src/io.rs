@@ -15,7 +15,7 @@
 
 use std::path::Path;
 
-use atelier_fabric::{ErrorKind, FileError, Position};
+use atelier_files::{ErrorKind, FileError, Position};
 
 use crate::build::first_open_edge;
 use crate::description::part_named;
@@ -87,7 +87,7 @@ pub fn load_mesh(path: &Path) -> Result<ExternalBody, FileError> {
 
 /// [`load_mesh`] with options.
 pub fn load_mesh_with(path: &Path, opts: &LoadOptions) -> Result<ExternalBody, FileError> {
-    let text = atelier_fabric::files::read_text(path)?;
+    let text = atelier_files::files::read_text(path)?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -578,12 +578,12 @@ pub fn ply_text(m: &ExternalBody) -> String {
 
 /// Write the mesh as OBJ, atomically.
 pub fn write_obj(path: &Path, m: &ExternalBody) -> std::io::Result<()> {
-    atelier_fabric::files::write_atomic(path, obj_text(m).as_bytes())
+    atelier_files::files::write_atomic(path, obj_text(m).as_bytes())
 }
 
 /// Write the mesh as ASCII PLY, atomically.
 pub fn write_ply(path: &Path, m: &ExternalBody) -> std::io::Result<()> {
-    atelier_fabric::files::write_atomic(path, ply_text(m).as_bytes())
+    atelier_files::files::write_atomic(path, ply_text(m).as_bytes())
 }
 
 #[cfg(test)]

@@ -111,6 +111,12 @@ impl Body {
 
     /// Pose the body: every vertex's position and velocity.
     pub fn pose_into(&self, rate: &PoseRate, out: &mut Posed) {
+        self.pose_with_frames(rate, out);
+    }
+
+    /// Pose the body as [`Body::pose_into`] does and return the parts' frames it computed on the
+    /// way (the same as [`Body::frames`]), so a caller that needs both runs the kinematics once.
+    pub fn pose_with_frames(&self, rate: &PoseRate, out: &mut Posed) -> [PartFrame; 17] {
         let frames = self.frames(rate);
         let n = self.rest.vertices.len();
         out.positions.resize(n, V3::zeros());
@@ -124,6 +130,7 @@ impl Body {
                 out.velocities[k] = fr.velocity + fr.omega.cross(&(x - fr.pivot));
             }
         }
+        frames
     }
 
     /// The body at time `t` of a motion.
@@ -325,9 +332,9 @@ mod tests {
 
     #[test]
     fn bad_motions_are_refused() {
-        use atelier_fabric::ErrorKind;
-        let parse = |text: &str| -> Result<MotionSpec, atelier_fabric::FileError> {
-            atelier_fabric::files::parse_ron(text, std::path::Path::new("motion.ron"))
+        use atelier_files::ErrorKind;
+        let parse = |text: &str| -> Result<MotionSpec, atelier_files::FileError> {
+            atelier_files::files::parse_ron(text, std::path::Path::new("motion.ron"))
         };
         let cases = [
             (

@@ -10,8 +10,8 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use atelier_fabric::check::{Validate, non_empty};
-use atelier_fabric::{ErrorKind, FileError, InvalidValue};
+use atelier_files::check::{Validate, non_empty};
+use atelier_files::{ErrorKind, FileError, InvalidValue};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -59,7 +59,7 @@ pub struct MotionSpec {
     pub keyframes: Vec<KeyframeSpec>,
 }
 
-atelier_fabric::validated!(MotionSpec);
+atelier_files::validated!(MotionSpec);
 
 impl Validate for MotionSpec {
     fn validate(&self) -> Result<(), InvalidValue> {
@@ -218,7 +218,7 @@ pub enum MotionError {
 impl Motion {
     /// Read a motion file and check it against `mannequin`'s joint limits.
     pub fn load(path: &Path, mannequin: &Mannequin) -> Result<Self, FileError> {
-        let spec: MotionSpec = atelier_fabric::files::load_ron(path)?;
+        let spec: MotionSpec = atelier_files::files::load_ron(path)?;
         Self::new(&spec, mannequin).map_err(|e| {
             let field = match &e {
                 MotionError::BeyondLimit {

@@ -82,7 +82,7 @@ pub fn validate(path: &Path) -> Outcome {
     }
     // A file that reads as a scenario is one: its later checks (ranges, metric names, the
     // files it names) must not lose to another format's parse error.
-    if let Ok(s) = atelier_fabric::files::load_ron::<atelier::scenario::Scenario>(path) {
+    if let Ok(s) = atelier_files::files::load_ron::<atelier::scenario::Scenario>(path) {
         return atelier::scenario::Scenario::load(path)
             .and_then(|_| {
                 s.check_files(&atelier::run::base_of(path))
@@ -112,10 +112,10 @@ pub fn validate(path: &Path) -> Outcome {
             atelier_body::Motion::load(p, &atelier_body::build::jis_9ar()).map(|_| ())
         }),
         (Kind::RangeSide, &|p| {
-            atelier_fabric::files::load_ron::<atelier_grid::range::SideFile>(p).map(|_| ())
+            atelier_files::files::load_ron::<atelier_grid::range::SideFile>(p).map(|_| ())
         }),
         (Kind::TryonPose, &|p| {
-            let pose: atelier_tryon::pose::PoseFile = atelier_fabric::files::load_ron(p)?;
+            let pose: atelier_tryon::pose::PoseFile = atelier_files::files::load_ron(p)?;
             pose.check().map_err(|e| FileError::from_invalid(p, e))
         }),
         (Kind::Scenario, &|p| {

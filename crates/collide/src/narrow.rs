@@ -16,6 +16,8 @@
 //! `t = 0` (resting contact; a point that ended a step exactly on the surface is not lost to
 //! rounding).
 
+use arrayvec::ArrayVec;
+
 use crate::geom::V3;
 
 /// A contact found by the narrow phase.
@@ -205,14 +207,16 @@ pub fn barycentric(p: &V3, x: [&V3; 3]) -> [f64; 3] {
 /// The real roots of `c₀ + c₁t + c₂t² + c₃t³` in `[0, T]`, ascending. The interval is split at
 /// the critical points (roots of the derivative), and every piece with a sign change (or an
 /// end at zero) is bisected to full precision, so no root is skipped for lack of a good start.
-pub fn cubic_roots_in(c: [f64; 4], t_max: f64) -> Vec<f64> {
+pub fn cubic_roots_in(c: [f64; 4], t_max: f64) -> ArrayVec<f64, 4> {
     let f = |t: f64| ((c[3] * t + c[2]) * t + c[1]) * t + c[0];
     let scale = c.iter().map(|v| v.abs()).fold(0.0, f64::max);
     if scale == 0.0 || !scale.is_finite() {
-        return Vec::new();
+        return ArrayVec::new();
     }
-    // Critical points of f: 3c₃t² + 2c₂t + c₁ = 0.
-    let mut knots = vec![0.0];
+    // Critical points of f: 3c₃t² + 2c₂t + c₁ = 0. At most two inside, so at most four knots
+    // and three roots: fixed-size buffers, no allocation per candidate.
+    let mut knots: ArrayVec<f64, 4> = ArrayVec::new();
+    knots.push(0.0);
     let (qa, qb, qc) = (3.0 * c[3], 2.0 * c[2], c[1]);
     if qa.abs() > 1e-300 {
         let disc = qb * qb - 4.0 * qa * qc;
@@ -220,7 +224,7 @@ pub fn cubic_roots_in(c: [f64; 4], t_max: f64) -> Vec<f64> {
             let sq = disc.sqrt();
             // Numerically stable pair.
             let q = -0.5 * (qb + qb.signum() * sq);
-            let mut r = Vec::new();
+            let mut r: ArrayVec<f64, 2> = ArrayVec::new();
             if q != 0.0 {
                 r.push(qc / q);
             }
@@ -240,7 +244,7 @@ pub fn cubic_roots_in(c: [f64; 4], t_max: f64) -> Vec<f64> {
     knots.push(t_max);
     knots.sort_by(f64::total_cmp);
     let tol = 1e-14 * scale;
-    let mut roots: Vec<f64> = Vec::new();
+    let mut roots: ArrayVec<f64, 4> = ArrayVec::new();
     for w in knots.windows(2) {
         let (mut lo, mut hi) = (w[0], w[1]);
         let (mut flo, fhi) = (f(lo), f(hi));
@@ -275,8 +279,17 @@ pub fn cubic_roots_in(c: [f64; 4], t_max: f64) -> Vec<f64> {
         }
         roots.push(0.5 * (lo + hi));
     }
-    roots.dedup_by(|a, b| (*a - *b).abs() <= 1e-15 * t_max.max(1e-300));
-    roots
+    // A root equal (within 1e-15·T) to the one kept before it is dropped (`Vec::dedup_by`'s rule).
+    let mut kept: ArrayVec<f64, 4> = ArrayVec::new();
+    for r in roots {
+        if kept
+            .last()
+            .is_none_or(|k| !((r - *k).abs() <= 1e-15 * t_max.max(1e-300)))
+        {
+            kept.push(r);
+        }
+    }
+    kept
 }
 
 #[cfg(test)]

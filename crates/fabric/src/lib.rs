@@ -23,16 +23,14 @@
 //!
 //! Modules: [`units`] (KES ↔ SI), [`tensile`], [`bending`], [`shear`], [`anisotropy`], [`fabric`] (the SI
 //! fabric and the per-angle [`MaterialTable`]), [`spec`] (the file format), [`plausibility`],
-//! [`files`] (RON loading with positioned errors, atomic writes), [`error`].
+//! and, re-exported from `atelier-files`, [`files`] (RON loading with positioned errors, atomic
+//! writes) and [`error`].
 
 pub mod anisotropy;
 pub mod bending;
 pub mod check;
-pub mod error;
 pub mod fabric;
-pub mod files;
 pub(crate) mod interp;
-pub mod noise;
 pub mod plausibility;
 pub mod shear;
 pub mod spec;
@@ -40,6 +38,8 @@ pub mod tensile;
 pub mod units;
 
 pub use anisotropy::{AnisotropyForm, Directions};
+/// The file plumbing, from `atelier-files` (kept at these paths for the fabric crate's users).
+pub use atelier_files::{error, files, noise, validated};
 pub use bending::{
     BendingState, KesBendingTest, Spindle, SpindleFit, fit_spindle, kes_bending_test,
 };

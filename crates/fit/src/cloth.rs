@@ -164,7 +164,7 @@ pub fn fit_cantilever(points: &[ProfilePoint], length: f64) -> Result<Cantilever
 #[cfg(test)]
 mod tests {
     use super::*;
-    use atelier_fabric::noise::Rng;
+    use atelier_files::noise::Rng;
 
     /// The elastica reproduces the reference numbers (`reference/elastica.md`): λ = 8.0042 gives
     /// the 41.5° chord with the tip at (0.7243, 0.6408)·L; small deflection y/L = λ/8.

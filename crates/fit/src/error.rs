@@ -30,7 +30,7 @@ pub enum FitError {
     /// A file that cannot be read, does not parse or holds a value out of range (file,
     /// line:column, field).
     #[error(transparent)]
-    File(#[from] atelier_fabric::FileError),
+    File(#[from] atelier_files::FileError),
 }
 
 impl FitError {

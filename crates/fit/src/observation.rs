@@ -21,7 +21,7 @@
 
 use std::path::Path;
 
-use atelier_fabric::{ErrorKind, FileError, InvalidValue, files};
+use atelier_files::{ErrorKind, FileError, InvalidValue, files};
 use serde::{Deserialize, Serialize};
 
 use crate::string::V2;

@@ -18,7 +18,7 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
-use atelier_fabric::noise::Rng;
+use atelier_files::noise::Rng;
 
 use crate::FitError;
 use crate::observation::{Observations, ObservedShape};

@@ -465,8 +465,8 @@ pub fn fit_turned(
 mod tests {
     use super::*;
     use crate::cloth::elastica;
-    use atelier_fabric::noise::Rng;
     use atelier_fabric::units;
+    use atelier_files::noise::Rng;
 
     /// Wool tropical (Matsudaira B): B 0.067 gf·cm²/cm, 2HB 0.033 gf·cm/cm, 16.29 mg/cm².
     fn wool() -> (f64, f64, f64) {

@@ -19,8 +19,8 @@ fn grid(name: &str) -> (PatternSpec, Panel) {
     (spec, panel)
 }
 
-fn parse(text: &str) -> Result<PatternSpec, atelier_fabric::FileError> {
-    atelier_fabric::files::parse_ron(text, Path::new("inline.ron"))
+fn parse(text: &str) -> Result<PatternSpec, atelier_files::FileError> {
+    atelier_files::files::parse_ron(text, Path::new("inline.ron"))
 }
 
 #[test]
@@ -317,7 +317,7 @@ fn a_depth_field_concentrates_nodes_under_the_hill() {
 /// Each kind of bad pattern is refused with a typed error naming file, position and field.
 #[test]
 fn bad_patterns_are_refused_with_positions() {
-    use atelier_fabric::ErrorKind;
+    use atelier_files::ErrorKind;
     let cases: [(&str, &str, ErrorKind, &str); 6] = [
         (
             "self-intersecting outline",
@@ -415,7 +415,7 @@ fn a_seam_between_teams_of_different_counts_is_refused() {
     )
     .expect("write");
     let e = load_garment(&dir.join("g.ron"), ImproveParams::default()).expect_err("counts differ");
-    assert_eq!(e.kind, atelier_fabric::ErrorKind::Inconsistent, "{e}");
+    assert_eq!(e.kind, atelier_files::ErrorKind::Inconsistent, "{e}");
     assert_eq!(e.field, "seams[1]");
     let pos = e.position.expect("positioned");
     assert_eq!((pos.line, pos.column), (6, 9), "{e}");
@@ -433,7 +433,7 @@ fn a_bad_spec_built_in_code_is_an_error_not_a_panic() {
         top[0].cells = 5;
     }
     let e = grid_pattern(&spec, ImproveParams::default()).expect_err("totals differ");
-    assert_eq!(e.kind, atelier_fabric::ErrorKind::Inconsistent);
+    assert_eq!(e.kind, atelier_files::ErrorKind::Inconsistent);
     let spec = parse(&SQUARE.replace("EXTRA", "")).expect("parses");
     let bad = ImproveParams {
         c2: f64::NAN,

@@ -87,7 +87,7 @@ fn error(
 /// expanded. 16-bit files are refused (the composite keeps the photograph's pixels bit for bit,
 /// which it could not do through an 8-bit reduction).
 fn decode(path: &Path) -> Result<(usize, usize, usize, Vec<u8>), FileError> {
-    let bytes = atelier_fabric::files::read_bytes(path)?;
+    let bytes = atelier_files::files::read_bytes(path)?;
     let png_err = |e: png::DecodingError| {
         error(
             path,

@@ -193,7 +193,7 @@ fn the_composite_keeps_the_photograph_outside_the_garment() {
     }
     // The fitted pose file reads back as a start pose.
     let fitted: PoseFile =
-        atelier_fabric::files::load_ron(&out.join("fitted_pose.ron")).expect("fitted pose");
+        atelier_files::files::load_ron(&out.join("fitted_pose.ron")).expect("fitted pose");
     fitted.check().expect("valid");
     assert!(fitted.camera.is_some() && fitted.sizes.is_some());
     std::fs::remove_dir_all(&dir).ok();
@@ -354,7 +354,7 @@ fn a_given_start_pose_is_where_the_fit_starts() {
     let start = PoseFile::from_angles(&e.angles, None, None);
     let text = ron::ser::to_string(&start).expect("serialises");
     let start: PoseFile =
-        atelier_fabric::files::parse_ron(&text, Path::new("start.ron")).expect("reads back");
+        atelier_files::files::parse_ron(&text, Path::new("start.ron")).expect("reads back");
     let options = FitOptions {
         description: jis_9ar_description(),
         height_cm: e.sizes.height_cm,

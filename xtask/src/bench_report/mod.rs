@@ -136,7 +136,7 @@ pub fn run(root: &Path, out: &Path, skip: &[Step]) -> Result<()> {
         .with_context(|| format!("reading {}", template.display()))?;
     let (rendered, figures) = render(&text, &sources)?;
     publish(&figures)?;
-    atelier_fabric::files::write_atomic(&root.join("docs/performance.md"), rendered.as_bytes())?;
+    atelier_files::files::write_atomic(&root.join("docs/performance.md"), rendered.as_bytes())?;
     eprintln!(
         "bench-report: wrote docs/performance.md ({:.0} s)",
         clock.elapsed().as_secs_f64()
@@ -479,7 +479,7 @@ fn publish(figures: &[(PathBuf, PathBuf)]) -> Result<()> {
         if let Some(dir) = to.parent() {
             std::fs::create_dir_all(dir)?;
         }
-        atelier_fabric::files::write_atomic(to, &bytes)?;
+        atelier_files::files::write_atomic(to, &bytes)?;
     }
     Ok(())
 }

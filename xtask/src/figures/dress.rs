@@ -101,7 +101,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
         )?;
     }
     let table = out.join("dress_fabrics.md");
-    atelier_fabric::files::write_atomic(&table, md.as_bytes())?;
+    atelier_files::files::write_atomic(&table, md.as_bytes())?;
     let (w, h, top, label) = (300usize, 420usize, 40usize, 36usize);
     let rows = dressed.len() / FABRICS.len();
     let path = png(

@@ -166,7 +166,7 @@ pub fn draw_all(_root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     )?;
     eprint!("{md}");
     let md_path = out.join("fit.md");
-    atelier_fabric::files::write_atomic(&md_path, md.as_bytes())
+    atelier_files::files::write_atomic(&md_path, md.as_bytes())
         .with_context(|| format!("writing {}", md_path.display()))?;
     let a = unobserved_chart(&out.join("fit_unobserved.png"), &results)?;
     let b = shapes_chart(&out.join("fit_shapes.png"), &results)?;

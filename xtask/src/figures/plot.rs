@@ -38,7 +38,7 @@ pub fn png(
     size: (u32, u32),
     draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<()>,
 ) -> Result<PathBuf> {
-    let tmp = atelier_fabric::files::temporary_sibling(path);
+    let tmp = atelier_files::files::temporary_sibling(path);
     let result = (|| {
         let root = BitMapBackend::new(&tmp, size).into_drawing_area();
         root.fill(&WHITE)?;

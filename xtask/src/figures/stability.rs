@@ -211,7 +211,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
         }
     }
     let table = out.join("stability.md");
-    atelier_fabric::files::write_atomic(&table, md.as_bytes())?;
+    atelier_files::files::write_atomic(&table, md.as_bytes())?;
     // Summary: per solver and speed, the largest Δt up to which every smaller step run was
     // stable, over the fabrics (smallest – largest).
     let mut summary = String::from("| solver |");
@@ -263,7 +263,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
         let _ = writeln!(summary, " {} |", beyond.join(", "));
     }
     let summary_path = out.join("stability_summary.md");
-    atelier_fabric::files::write_atomic(&summary_path, summary.as_bytes())?;
+    atelier_files::files::write_atomic(&summary_path, summary.as_bytes())?;
     let rows = FABRICS.len() * SPEEDS.len();
     let (cell_w, cell_h, left, top) = (40i32, 22i32, 150i32, 70i32);
     let panel_w = left + cell_w * STEPS_MS.len() as i32 + 30;

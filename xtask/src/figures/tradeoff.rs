@@ -383,7 +383,7 @@ pub fn run(out: &Path, quick: bool) -> Result<()> {
             &tighter_cfg,
             uncertainty,
         );
-        atelier_fabric::files::write_atomic(&md, text.as_bytes())?;
+        atelier_files::files::write_atomic(&md, text.as_bytes())?;
         let pic = out.join(format!("tradeoff_{}.png", scene.name));
         png(&pic, (1300, 850), |area| {
             draw(area, &scene, &rows, uncertainty)

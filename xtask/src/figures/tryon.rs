@@ -146,7 +146,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
             picture("composite.png")?,
         ]);
         let path = out.join(format!("tryon_{}.png", e.name));
-        atelier_fabric::files::write_atomic(&path, &encode(tw, th, 3, &data)?)?;
+        atelier_files::files::write_atomic(&path, &encode(tw, th, 3, &data)?)?;
         written.push(path);
     }
     writeln!(
@@ -186,7 +186,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
         )?;
     }
     let path = out.join("tryon.md");
-    atelier_fabric::files::write_atomic(&path, md.as_bytes())?;
+    atelier_files::files::write_atomic(&path, md.as_bytes())?;
     eprint!("{md}");
     written.push(path);
     Ok(written)

@@ -269,7 +269,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
 
     eprint!("{md}");
     let md_path = out.join("wet.md");
-    atelier_fabric::files::write_atomic(&md_path, md.as_bytes())
+    atelier_files::files::write_atomic(&md_path, md.as_bytes())
         .with_context(|| format!("writing {}", md_path.display()))?;
     let chart = speed_chart(&out.join("wet_speed.png"), &speed)?;
     Ok(vec![md_path, chart])

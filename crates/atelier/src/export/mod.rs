@@ -409,7 +409,7 @@ fn write_atomically(
     path: &Path,
     body: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
 ) -> Result<(), ExportError> {
-    let tmp = atelier_fabric::files::temporary_sibling(path);
+    let tmp = atelier_files::files::temporary_sibling(path);
     let result = (|| {
         let mut w = BufWriter::new(File::create(&tmp)?);
         body(&mut w)?;

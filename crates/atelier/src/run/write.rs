@@ -29,7 +29,7 @@ pub(super) fn write_outputs(
         let (w, h) = options.picture;
         let io = |path: PathBuf| move |source| RunError::Output { path, source };
         let path = out.join(outputs::PARAMETERS);
-        atelier_fabric::files::write_atomic(&path, fit.parameters_ron.as_bytes())
+        atelier_files::files::write_atomic(&path, fit.parameters_ron.as_bytes())
             .map_err(io(path))?;
         written.push(outputs::PARAMETERS.into());
         if let Some(chart) = &sim.chart {
@@ -180,7 +180,7 @@ fn write_wet_outputs(
         written.push(name.into());
     }
     let path = out.join(outputs::SERIES);
-    atelier_fabric::files::write_atomic(&path, wet.series_csv.as_bytes()).map_err(io(path))?;
+    atelier_files::files::write_atomic(&path, wet.series_csv.as_bytes()).map_err(io(path))?;
     written.push(outputs::SERIES.into());
     for (name, chart) in &wet.charts {
         write_chart(

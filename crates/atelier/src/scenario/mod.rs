@@ -436,17 +436,17 @@ impl Scenario {
     /// Read and check a scenario file.
     pub fn load(path: &Path) -> Result<Self, FileError> {
         let text = std::fs::read_to_string(path).unwrap_or_default();
-        let s: Scenario = atelier_fabric::files::load_ron(path)?;
+        let s: Scenario = atelier_files::files::load_ron(path)?;
         s.check()
-            .map_err(|e| atelier_fabric::files::located(path, &text, e))?;
+            .map_err(|e| atelier_files::files::located(path, &text, e))?;
         Ok(s)
     }
 
     /// Parse and check scenario text; `file` names it in errors.
     pub fn parse(text: &str, file: &Path) -> Result<Self, FileError> {
-        let s: Scenario = atelier_fabric::files::parse_ron(text, file)?;
+        let s: Scenario = atelier_files::files::parse_ron(text, file)?;
         s.check()
-            .map_err(|e| atelier_fabric::files::located(file, text, e))?;
+            .map_err(|e| atelier_files::files::located(file, text, e))?;
         Ok(s)
     }
 

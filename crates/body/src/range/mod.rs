@@ -109,7 +109,7 @@ pub enum RangeError {
     },
     /// The views could not be turned into a [`RangeBody`].
     #[error("inconsistent views: {0}")]
-    Views(#[from] atelier_fabric::FileError),
+    Views(#[from] atelier_files::FileError),
     /// Gridding the rendered body failed.
     #[error(transparent)]
     Grid(#[from] GridError),

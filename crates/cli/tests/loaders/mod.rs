@@ -158,7 +158,7 @@ pub const CLOTH: &str = r#"ClothObservations(
 
 /// A try-on start pose (`--pose`, the format of `fitted_pose.ron`): parse and check.
 pub fn load_pose(text: String) {
-    if let Ok(pose) = atelier_fabric::files::parse_ron::<atelier_tryon::pose::PoseFile>(
+    if let Ok(pose) = atelier_files::files::parse_ron::<atelier_tryon::pose::PoseFile>(
         &text,
         Path::new("hostile_pose.ron"),
     ) {

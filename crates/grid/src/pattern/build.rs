@@ -5,7 +5,7 @@
 
 use std::f64::consts::PI;
 
-use atelier_fabric::{ErrorKind, InvalidValue};
+use atelier_files::{ErrorKind, InvalidValue};
 
 use super::spec::{DartSpec, Outline, PatternSpec, ResolvedTeam, find_team};
 use crate::coons::{coons, coons_periodic, resample};
@@ -72,7 +72,7 @@ pub type BuildError = InvalidValue;
 /// The spec is checked first (a spec built in code has not been through the parser's checks), so
 /// bad input is an error, never a panic.
 pub fn grid_pattern(spec: &PatternSpec, params: ImproveParams) -> Result<Panel, BuildError> {
-    atelier_fabric::check::Validate::validate(spec)?;
+    atelier_files::check::Validate::validate(spec)?;
     for (name, c) in [("c1", params.c1), ("c2", params.c2), ("c3", params.c3)] {
         if !(c.is_finite() && c >= 0.0) {
             return Err(InvalidValue::new(

@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use atelier_fabric::check::non_empty;
-use atelier_fabric::files::load_ron;
-use atelier_fabric::{ErrorKind, FileError, Position};
+use atelier_files::check::non_empty;
+use atelier_files::files::load_ron;
+use atelier_files::{ErrorKind, FileError, Position};
 use serde::{Deserialize, Serialize};
 
 use super::build::{Panel, grid_pattern};

@@ -1,8 +1,8 @@
 //! The pattern file (RON, cm): what a user writes. Checked while it is parsed, so an error names
 //! the file, the position, the field and the value.
 
-use atelier_fabric::check::{Validate, non_empty, positive};
-use atelier_fabric::{ErrorKind, InvalidValue};
+use atelier_files::check::{Validate, non_empty, positive};
+use atelier_files::{ErrorKind, InvalidValue};
 use serde::{Deserialize, Serialize};
 
 use super::geometry::{Point, Segment, contains, flatten, self_intersection};
@@ -145,7 +145,7 @@ pub struct ImproveSpec {
     pub max_iterations: usize,
 }
 
-atelier_fabric::validated!(PatternSpec);
+atelier_files::validated!(PatternSpec);
 
 /// One team with its resolved geometry: start, flattened polyline (cm).
 #[derive(Clone, Debug)]

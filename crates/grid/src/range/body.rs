@@ -3,8 +3,8 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use atelier_fabric::files::load_ron;
-use atelier_fabric::{ErrorKind, FileError, InvalidValue};
+use atelier_files::files::load_ron;
+use atelier_files::{ErrorKind, FileError, InvalidValue};
 
 use super::image::{GrayImage, read_image};
 use super::side::{SideFile, View};

@@ -8,8 +8,8 @@
 
 use std::path::Path;
 
-use atelier_fabric::files::write_atomic;
-use atelier_fabric::{ErrorKind, FileError, Position};
+use atelier_files::files::write_atomic;
+use atelier_files::{ErrorKind, FileError, Position};
 
 /// A grey-level image, row by row from the top, values as read (0..=maxval).
 #[derive(Clone, Debug, PartialEq, Eq)]

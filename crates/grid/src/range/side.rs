@@ -18,9 +18,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use atelier_fabric::check::{self, Validate, validated};
-use atelier_fabric::files::write_atomic;
-use atelier_fabric::{ErrorKind, InvalidValue};
+use atelier_files::check::{self, Validate, validated};
+use atelier_files::files::write_atomic;
+use atelier_files::{ErrorKind, InvalidValue};
 use serde::{Deserialize, Serialize};
 
 /// Which camera took a range image.
@@ -122,7 +122,7 @@ impl SideFile {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use atelier_fabric::files::parse_ron;
+    use atelier_files::files::parse_ron;
 
     fn side() -> SideFile {
         SideFile {

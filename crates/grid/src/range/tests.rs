@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use atelier_fabric::ErrorKind;
+use atelier_files::ErrorKind;
 
 use super::synthetic::Mannequin;
 use super::*;

@@ -83,7 +83,7 @@ fn walking_skirt(
 
     let body = Body::new(atelier_body::build::jis_9ar());
     let path = crate::common::root().join("fixtures/motions/walk.ron");
-    let mut spec: MotionSpec = atelier_fabric::files::load_ron(&path).expect("walk");
+    let mut spec: MotionSpec = atelier_files::files::load_ron(&path).expect("walk");
     for k in &mut spec.keyframes {
         k.root_cm.2 = 0.0; // walk in place
     }

@@ -605,7 +605,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     );
     std::io::stdout().write_all(table.as_bytes())?;
     let md = out.join("time_vs_error.md");
-    atelier_fabric::files::write_atomic(&md, table.as_bytes())?;
+    atelier_files::files::write_atomic(&md, table.as_bytes())?;
     let png_path = out.join("time_vs_error.png");
     let written = png(&png_path, (1700, 850), |root| {
         draw(root, &rows, uncertainty)
