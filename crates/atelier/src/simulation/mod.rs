@@ -75,14 +75,7 @@ impl Timings {
     pub fn add(&mut self, t: &Timings) {
         self.body += t.body;
         self.diagnostics += t.diagnostics;
-        let (s, o) = (&mut self.solver, &t.solver);
-        s.bending += o.bending;
-        s.internal += o.internal;
-        s.velocity += o.velocity;
-        s.transfer += o.transfer;
-        s.shape += o.shape;
-        s.collision += o.collision;
-        s.update += o.update;
+        self.solver += &t.solver;
     }
 }
 
@@ -207,9 +200,9 @@ impl Simulation {
         };
         if let Some(m) = &scene.motion {
             let first = m.sample(0.0);
-            scene.body.pose_into(&first, &mut posed);
+            let frames = scene.body.pose_with_frames(&first, &mut posed);
             posed.velocities.iter_mut().for_each(|v| *v = V3::zeros());
-            part_motions(&scene.body, &first, &mut start_pose);
+            part_motions(&scene.body, &frames, &mut start_pose);
         }
         let standing = LabelledMesh {
             vertices: posed.positions.clone(),
@@ -577,7 +570,9 @@ impl Simulation {
                 r.linear_iterations += a.linear_iterations + whole.linear_iterations;
                 r.internal_iterations += a.internal_iterations + whole.internal_iterations;
                 r.max_strain_error = r.max_strain_error.max(a.max_strain_error);
-                r.timings = add_stages(&add_stages(&whole.timings, &a.timings), &b.timings);
+                r.timings = whole.timings;
+                r.timings += &a.timings;
+                r.timings += &b.timings;
                 Ok((r, na + nb))
             }
             Err(_) => {
@@ -599,10 +594,10 @@ impl Simulation {
             let clock = Instant::now();
             let (a, b) = (m.sample(tm), m.sample(tm + h));
             let body = &self.scene.body;
-            body.pose_into(&a, &mut self.posed);
-            body.pose_into(&b, &mut self.next_posed);
-            part_motions(body, &a, &mut self.motion_start);
-            part_motions(body, &b, &mut self.motion_end);
+            let frames_a = body.pose_with_frames(&a, &mut self.posed);
+            let frames_b = body.pose_with_frames(&b, &mut self.next_posed);
+            part_motions(body, &frames_a, &mut self.motion_start);
+            part_motions(body, &frames_b, &mut self.motion_end);
             self.contact
                 .set_body(
                     &self.posed.positions,
@@ -637,20 +632,6 @@ impl Simulation {
             std::mem::swap(&mut self.posed, &mut self.next_posed);
         }
         Ok(report)
-    }
-}
-
-/// Two steps' stage times added.
-fn add_stages(a: &StageTimings, b: &StageTimings) -> StageTimings {
-    StageTimings {
-        bending: a.bending + b.bending,
-        internal: a.internal + b.internal,
-        velocity: a.velocity + b.velocity,
-        shape: a.shape + b.shape,
-        collision: a.collision + b.collision,
-        transfer: a.transfer + b.transfer,
-        update: a.update + b.update,
-        pressure: a.pressure + b.pressure,
     }
 }
 

@@ -1,8 +1,8 @@
 //! Set-up helpers of a garment scene: seam groups (nodes tied at length 0), the body parts'
 //! motion over a step, and the body's triangles the cloth can reach.
 
+use atelier_body::kinematics::PartFrame;
 use atelier_body::model::LabelledMesh;
-use atelier_body::motion::PoseRate;
 use atelier_collide::RigidParts;
 use atelier_collide::parts::Motion as PartMotion;
 use rayon::prelude::*;
@@ -25,13 +25,13 @@ pub(super) fn seam_groups(n: usize, pairs: &[(u32, u32)]) -> Vec<u32> {
     (0..n as u32).map(|i| root(&mut parent, i)).collect()
 }
 
-/// The rigid motion of every part (rest → world) in a pose, in the mannequin's part order.
+/// The rigid motion of every part (rest → world) for the parts' `frames` in a pose (from
+/// [`atelier_body::kinematics::Body::pose_with_frames`]), in the mannequin's part order.
 pub(super) fn part_motions(
     body: &atelier_body::kinematics::Body,
-    rate: &PoseRate,
+    frames: &[PartFrame; 17],
     out: &mut [PartMotion],
 ) {
-    let frames = body.frames(rate);
     for (m, part) in out.iter_mut().zip(&body.mannequin.parts) {
         let f = frames[part.part.index()];
         let r = f.rotation;

@@ -105,6 +105,20 @@ pub struct StageTimings {
     pub pressure: Duration,
 }
 
+impl std::ops::AddAssign<&StageTimings> for StageTimings {
+    /// Every stage's time added, the pressure force's included.
+    fn add_assign(&mut self, o: &StageTimings) {
+        self.bending += o.bending;
+        self.internal += o.internal;
+        self.velocity += o.velocity;
+        self.shape += o.shape;
+        self.collision += o.collision;
+        self.transfer += o.transfer;
+        self.update += o.update;
+        self.pressure += o.pressure;
+    }
+}
+
 impl StageTimings {
     /// Sum of all stages.
     pub fn total(&self) -> Duration {
