@@ -25,9 +25,7 @@ fn load(spec: &StringFitSpec, base: &Path) -> Result<Observations, RunError> {
         Source::Synthetic(o) => observe(*o, &SyntheticOptions::default())
             .map(|(obs, _)| obs)
             .map_err(|e| RunError::Setup(format!("synthetic {}: {e}", o.name()))),
-        Source::File(p) => {
-            Observations::load(&base.join(p)).map_err(|e| RunError::Setup(e.to_string()))
-        }
+        Source::File(p) => Observations::load(&base.join(p)).map_err(RunError::from),
     }
 }
 

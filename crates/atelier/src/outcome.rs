@@ -9,15 +9,26 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::chart::Chart;
+use atelier_fabric::FileError;
+
 use crate::convergence::Convergence;
 use crate::export::Animation;
+use crate::scene::SceneError;
 use crate::simulation::Timings;
 
 /// Why a scenario could not be run or its outputs not written. (A run that diverges is not an
 /// error: it is a [`Simulated`] with a failure, and its outputs are written.)
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
-    /// The scene could not be set up (a file it names, a parameter out of range).
+    /// A file the scenario names could not be read (the error names the file, the position and
+    /// the field).
+    #[error(transparent)]
+    File(#[from] FileError),
+    /// The garment scene could not be set up (its files, its body, its sewing).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// Another scene kind could not be set up (a parameter out of range, a grid or cloth that
+    /// cannot be built); the message says which scene and why.
     #[error("{0}")]
     Setup(String),
     /// The output folder could not be created or written.

@@ -159,11 +159,10 @@ pub fn posed_scene(
         spec.placements.clone(),
         spec.place,
     )
-    .map_err(|e| RunError::Setup(e.to_string()))?;
+    .map_err(RunError::from)?;
     let mut settings = spec.settings.clone();
     settings.motion_time = motion_s + HOLD_S;
-    Ok(Scene::new(garment, mannequin, Some(motion), settings)
-        .map_err(|e| RunError::Setup(e.to_string()))?)
+    Ok(Scene::new(garment, mannequin, Some(motion), settings).map_err(RunError::from)?)
 }
 
 /// Run a try-on into `out`: fit, dress, move, composite; writes `composite.png`,
@@ -193,7 +192,7 @@ pub fn tryon(
     let start = match &inputs.pose {
         None => PoseFile::default(),
         Some(p) => {
-            let start: PoseFile = atelier_fabric::files::load_ron(p)?;
+            let start: PoseFile = atelier_files::files::load_ron(p)?;
             start.check().map_err(|e| FileError::from_invalid(p, e))?;
             start
         }
@@ -238,7 +237,7 @@ pub fn tryon(
     );
     let write = |name: &str, bytes: &[u8]| -> Result<(), RunError> {
         let path = out.join(name);
-        atelier_fabric::files::write_atomic(&path, bytes)
+        atelier_files::files::write_atomic(&path, bytes)
             .map_err(|source| RunError::Output { path, source })
     };
     let io = |e: std::io::Error| RunError::Output {

@@ -214,7 +214,7 @@ pub fn simulate(
         return Ok(sim);
     };
     let fabric_path = base.join(fabric_file);
-    let fabric = Fabric::load(&fabric_path).map_err(|e| RunError::Setup(e.to_string()))?;
+    let fabric = Fabric::load(&fabric_path)?;
     let mut sim = match &scenario.kind {
         ScenarioKind::Garment(spec) => garment(spec, base, progress)?,
         ScenarioKind::Drape(spec) => drape(spec, &fabric, progress)?,
@@ -239,8 +239,7 @@ pub fn simulate_scene(
 ) -> Result<Simulated, RunError> {
     let dt = scene.settings.dt;
     let fabric = scene.garment.fabric.name.clone();
-    let run =
-        crate::pipeline::run_scene(scene, progress).map_err(|e| RunError::Setup(e.to_string()))?;
+    let run = crate::pipeline::run_scene(scene, progress)?;
     let mut sim = garment_simulated(run, dt);
     sim.fabric = fabric;
     finish_simulated(&mut sim);
@@ -309,7 +308,7 @@ fn garment(
     base: &Path,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Simulated, RunError> {
-    let run = run_garment(spec, base, progress).map_err(|e| RunError::Setup(e.to_string()))?;
+    let run = run_garment(spec, base, progress)?;
     Ok(garment_simulated(run, spec.settings.dt))
 }
 
