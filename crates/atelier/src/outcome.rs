@@ -74,7 +74,7 @@ pub struct Simulated {
     pub wall_seconds: f64,
     /// Wall time per stage, summed over the steps.
     pub timings: Timings,
-    /// Metrics by name (see [`ScenarioKind::metric_names`]); `None` when not measured (for
+    /// Metrics by name (see [`crate::scenario::ScenarioKind::metric_names`]); `None` when not measured (for
     /// example a drape coefficient after a failed step).
     pub metrics: BTreeMap<String, Option<f64>>,
     /// Things the user should know.

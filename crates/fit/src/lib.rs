@@ -6,7 +6,7 @@
 //! held), the model's parameters — per segment the spring coefficient s and natural length l,
 //! per inner particle the bending coefficient b and natural bend φ — are found together with
 //! the model's node positions for every shape so that the nodes lie on the markers and every
-//! inner node is in equilibrium ([`identify`], Levenberg–Marquardt with an analytic Jacobian).
+//! inner node is in equilibrium ([`identify`](fn@identify), Levenberg–Marquardt with an analytic Jacobian).
 //! [`string::StringModel::equilibrium`] then reproduces any shape for given end positions.
 
 pub mod cloth;

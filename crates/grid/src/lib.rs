@@ -2,7 +2,7 @@
 //!
 //! Boundary-fitted structured grids for cloth and bodies (thesis §4; `method.md` §4): the initial
 //! grid by arc-length spacing and Coons patches ([`coons`]), its improvement by smoothness, shear
-//! and spacing energies on a plane, a height field or a range image ([`improve`]), sewing patterns
+//! and spacing energies on a plane, a height field or a range image ([`improve`](fn@improve)), sewing patterns
 //! with teams, darts, pleats and seams ([`pattern`]), bodies from front and back range images
 //! ([`range`]), grid quality ([`quality`]), and the cooked cloth topology the solver consumes
 //! ([`ClothTopology`]).

@@ -1,6 +1,6 @@
 //! A structured patch under construction: `nu × nv` grid slots, each holding a node or nothing
 //! (inside a dart), several slots may share one node (a dart's apex), and nodes may be fixed
-//! (boundary, dart and pleat lines, fixed points). The improvement ([`crate::improve`]) moves the
+//! (boundary, dart and pleat lines, fixed points). The improvement ([`crate::improve`](fn@crate::improve)) moves the
 //! free nodes; [`crate::topology`] cooks the result.
 
 use crate::topology::NO_NODE;

@@ -15,7 +15,7 @@ pub enum InternalMethod {
     Accelerated,
 }
 
-/// How the shape constraints (49)–(51) are solved ([`crate::shape`]).
+/// How the shape constraints (49)–(51) are solved (the step's shape stage, [`crate::step`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum ShapeMethod {
     /// Full Newton on the saddle-point (KKT) system with the geometric stiffness of the rows in

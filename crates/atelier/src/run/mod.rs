@@ -3,7 +3,7 @@
 //! run as an animated glTF binary and pictures of the final state ([`run`]).
 //!
 //! This file dispatches a scenario to its kind and writes the report; the validation scenes
-//! are in [`validation`], the exports and pictures in [`write`].
+//! are in `validation`, the exports and pictures in `write`.
 //!
 //! Every file is written under a temporary name beside its target and renamed when complete;
 //! the report is written last, so a folder whose `report.json` is new holds a complete set. A
