@@ -16,6 +16,7 @@ pub mod bend_angle;
 pub mod cloth;
 pub mod contact;
 pub mod dual;
+pub mod integrator;
 pub mod kes;
 pub mod kkt;
 pub mod leg;

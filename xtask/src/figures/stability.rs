@@ -16,9 +16,13 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use atelier_fabric::{AnisotropyForm, Fabric};
+use atelier_fabric::{AnisotropyForm, Fabric, STANDARD_GRAVITY};
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
+use atelier_solver::integrator::{
+    Integrator, MassSpringIntegrator, Party, StepInput, XpbdIntegrator,
+};
+use atelier_solver::step::NoCollision;
 use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
 use nalgebra::Vector3;
 use plotters::prelude::*;
@@ -106,28 +110,30 @@ fn run(solver: &str, fabric: &Fabric, speed: f64, dt: f64) -> Result<(Outcome, f
     let (cloth, mut state) = scene(fabric, speed)?;
     let steps = (DURATION / dt).round() as usize;
     let check_every = ((0.05 / dt).round() as usize).max(1);
-    let mut party = Solver::new();
-    let mut mass_spring = MassSpring::new();
-    let mut xpbd = Xpbd::new();
-    let party_params = StepParams {
-        dt,
-        ..StepParams::default()
+    // One interface for the three integrators: Δt and gravity are given with every step.
+    let mut integrator: Box<dyn Integrator> = match solver {
+        "PARTY" => Box::new(Party {
+            solver: Solver::new(),
+            params: StepParams::default(),
+        }),
+        "mass-spring" => Box::new(MassSpringIntegrator {
+            solver: MassSpring::new(),
+            params: MassSpringParams::default(),
+        }),
+        _ => Box::new(XpbdIntegrator {
+            solver: Xpbd::new(),
+            params: XpbdParams::default(),
+        }),
     };
-    let ms_params = MassSpringParams {
+    let input = StepInput {
         dt,
-        ..MassSpringParams::default()
-    };
-    let xpbd_params = XpbdParams {
-        dt,
-        ..XpbdParams::default()
+        gravity: [0.0, 0.0, -STANDARD_GRAVITY],
     };
     let mut worst: f64 = 0.0;
     for k in 1..=steps {
-        let ok = match solver {
-            "PARTY" => party.step(&cloth, &mut state, &party_params).is_ok(),
-            "mass-spring" => mass_spring.step(&cloth, &mut state, &ms_params).is_ok(),
-            _ => xpbd.step(&cloth, &mut state, &xpbd_params).is_ok(),
-        };
+        let ok = integrator
+            .advance(&cloth, &mut state, input, &mut NoCollision)
+            .is_ok();
         if !ok
             || state
                 .positions

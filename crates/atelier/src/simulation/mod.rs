@@ -23,7 +23,8 @@ use atelier_body::kinematics::Posed;
 use atelier_body::model::LabelledMesh;
 use atelier_collide::parts::Motion as PartMotion;
 use atelier_collide::{ContactMaterial, ContactParams, RigidParts, V3};
-use atelier_solver::baselines::{BaselineReport, MassSpring, MassSpringParams, Xpbd, XpbdParams};
+use atelier_solver::baselines::{MassSpring, Xpbd};
+use atelier_solver::integrator::{Integrator, MassSpringIntegrator, StepInput, XpbdIntegrator};
 use atelier_solver::{
     BodyContact, ClothState, Solver, StageTimings, StepError, StepParams, StepReport,
 };
@@ -125,45 +126,14 @@ pub struct StepOutcome {
     pub contacts: atelier_collide::PassStats,
 }
 
-/// A baseline solver stepping the garment instead of PARTY (`settings.solver`), with its
-/// parameters (Δt the scene's, gravity as the schedule says).
-enum Baseline {
-    /// PARTY: `Simulation::solver` with `Simulation::params`.
-    None,
-    Xpbd(Box<Xpbd>, XpbdParams),
-    MassSpring(Box<MassSpring>, MassSpringParams),
-}
-
-impl Baseline {
-    fn set_gravity(&mut self, g: [f64; 3]) {
-        match self {
-            Self::None => {}
-            Self::Xpbd(_, p) => p.gravity = g,
-            Self::MassSpring(_, p) => p.gravity = g,
-        }
-    }
-}
-
-/// A baseline's diagnostics in the PARTY step's report: its sweeps as shape iterations, its
-/// largest strain |l/l⁰ − 1| as the strain error (a baseline's springs rest at l⁰), its timings.
-fn baseline_step_report(r: BaselineReport) -> StepReport {
-    StepReport {
-        shape_iterations: r.iterations,
-        max_strain_error: r.max_strain,
-        kinetic_energy: r.kinetic_energy,
-        max_speed: r.max_speed,
-        tolerance_factor: 1.0,
-        timings: r.timings,
-        ..StepReport::default()
-    }
-}
-
 /// A garment scene being simulated.
 pub struct Simulation {
     scene: Scene,
     state: ClothState,
     solver: Solver,
-    baseline: Baseline,
+    /// A baseline integrator stepping the garment instead of PARTY (`settings.solver`), with its
+    /// parameters; `None`: PARTY, `solver` with `params`.
+    baseline: Option<Box<dyn Integrator>>,
     sewing: Sewing,
     contact: BodyContact,
     params: StepParams,
@@ -294,24 +264,16 @@ impl Simulation {
             gravity: [0.0; 3],
             ..settings.step.clone()
         };
-        let baseline = match &settings.solver {
-            ClothSolver::Party => Baseline::None,
-            ClothSolver::Xpbd(p) => Baseline::Xpbd(
-                Box::new(Xpbd::new()),
-                XpbdParams {
-                    dt: settings.dt,
-                    gravity: [0.0; 3],
-                    ..p.clone()
-                },
-            ),
-            ClothSolver::MassSpring(p) => Baseline::MassSpring(
-                Box::new(MassSpring::new()),
-                MassSpringParams {
-                    dt: settings.dt,
-                    gravity: [0.0; 3],
-                    ..p.clone()
-                },
-            ),
+        let baseline: Option<Box<dyn Integrator>> = match &settings.solver {
+            ClothSolver::Party => None,
+            ClothSolver::Xpbd(p) => Some(Box::new(XpbdIntegrator {
+                solver: Xpbd::new(),
+                params: p.clone(),
+            })),
+            ClothSolver::MassSpring(p) => Some(Box::new(MassSpringIntegrator {
+                solver: MassSpring::new(),
+                params: p.clone(),
+            })),
         };
         Ok(Self {
             state,
@@ -477,7 +439,6 @@ impl Simulation {
     fn start_settling(&mut self) {
         self.phase = Phase::Settling;
         self.params.gravity = self.scene.settings.gravity;
-        self.baseline.set_gravity(self.scene.settings.gravity);
         if self.scene.settings.self_collision {
             self.contact.set_self_collision(true);
         }
@@ -541,7 +502,7 @@ impl Simulation {
         depth: u32,
         timings: &mut Timings,
     ) -> Result<(StepReport, usize), Failure> {
-        let before = (depth > 0 && matches!(self.baseline, Baseline::None))
+        let before = (depth > 0 && self.baseline.is_none())
             .then(|| (self.state.clone(), self.posed.clone()));
         let whole = self.cloth_step(tm, h, moving, timings)?;
         let Some((state, posed)) = before.filter(|_| !whole.converged) else {
@@ -616,16 +577,16 @@ impl Simulation {
         let mut hooks = Chain(vec![&mut self.sewing, &mut self.contact]);
         let cloth = &self.scene.garment.cloth.cloth;
         let report = match &mut self.baseline {
-            Baseline::None => {
-                self.solver
-                    .step_with(cloth, &mut self.state, &self.params, &mut hooks)
+            None => self
+                .solver
+                .step_with(cloth, &mut self.state, &self.params, &mut hooks),
+            Some(integrator) => {
+                let input = StepInput {
+                    dt: h,
+                    gravity: self.params.gravity,
+                };
+                integrator.advance(cloth, &mut self.state, input, &mut hooks)
             }
-            Baseline::Xpbd(solver, p) => solver
-                .step_with(cloth, &mut self.state, p, &mut hooks)
-                .map(baseline_step_report),
-            Baseline::MassSpring(solver, p) => solver
-                .step_with(cloth, &mut self.state, p, &mut hooks)
-                .map(baseline_step_report),
         }
         .map_err(Failure::Step)?;
         if moving {
