@@ -11,7 +11,9 @@ use std::path::{Path, PathBuf};
 use atelier_body::kinematics::Body;
 use atelier_body::model::Mannequin;
 use atelier_body::motion::Motion;
-use atelier_fabric::{AnisotropyForm, ErrorKind, Fabric, InvalidValue, STANDARD_GRAVITY};
+use atelier_fabric::{
+    AnisotropyForm, ErrorKind, Fabric, FileError, InvalidValue, STANDARD_GRAVITY,
+};
 use atelier_grid::ImproveParams;
 use atelier_grid::pattern::load_garment;
 use atelier_solver::StepParams;
@@ -375,9 +377,17 @@ pub struct Garment {
 /// Why a scene could not be set up.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// A file could not be read or is invalid (the message names file, position and field).
-    #[error("{0}")]
-    File(String),
+    /// A file could not be read or is invalid (the error names file, position and field).
+    #[error(transparent)]
+    File(#[from] FileError),
+    /// The body description's mannequin could not be built (the file named first).
+    #[error("{}: {source}", file.display())]
+    Mannequin {
+        /// The body description.
+        file: PathBuf,
+        /// Why.
+        source: atelier_body::build::BodyError,
+    },
     /// The garment could not be assembled.
     #[error(transparent)]
     Assemble(#[from] crate::AssembleError),
@@ -401,9 +411,8 @@ impl Garment {
         placements: Vec<Placement>,
         place: PlaceParams,
     ) -> Result<Self, SceneError> {
-        let pattern = load_garment(garment, ImproveParams::default())
-            .map_err(|e| SceneError::File(e.to_string()))?;
-        let fabric = Fabric::load(fabric).map_err(|e| SceneError::File(e.to_string()))?;
+        let pattern = load_garment(garment, ImproveParams::default())?;
+        let fabric = Fabric::load(fabric)?;
         if placements.len() != pattern.panels.len() {
             return Err(crate::place::PlaceError::Count {
                 placements: placements.len(),
@@ -464,17 +473,19 @@ impl Scene {
         let mannequin = match &spec.body {
             None => atelier_body::build::jis_9ar(),
             Some(p) => {
-                let d = atelier_body::description::BodyDescription::load(&resolve(p))
-                    .map_err(|e| SceneError::File(e.to_string()))?;
-                Mannequin::from_description(&d, &d.sizes)
-                    .map_err(|e| SceneError::File(format!("{}: {e}", p.display())))?
+                let d = atelier_body::description::BodyDescription::load(&resolve(p))?;
+                Mannequin::from_description(&d, &d.sizes).map_err(|source| {
+                    SceneError::Mannequin {
+                        file: p.clone(),
+                        source,
+                    }
+                })?
             }
         };
         let motion = match &spec.motion {
-            Some(p) if spec.settings.motion_time > 0.0 => Some(
-                Motion::load(&resolve(p), &mannequin)
-                    .map_err(|e| SceneError::File(e.to_string()))?,
-            ),
+            Some(p) if spec.settings.motion_time > 0.0 => {
+                Some(Motion::load(&resolve(p), &mannequin)?)
+            }
             _ => None,
         };
         Self::new(garment, mannequin, motion, spec.settings.clone())
