@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::chart::{Chart, Series};
 use crate::export::Animation;
 pub use crate::outcome::FitOutputs;
-use crate::outcome::{RunError, Simulated};
+use crate::outcome::{KindOutputs, RunError, Simulated};
 pub use crate::scenario::string_fit::{Initial, METRICS, Source, StringFitSpec};
 use crate::simulation::Timings;
 
@@ -159,10 +159,7 @@ pub fn simulate(spec: &StringFitSpec, base: &Path) -> Result<Simulated, RunError
         metrics,
         warnings,
         failure: None,
-        chart: Some(chart),
-        wet: None,
-        fit: Some(Box::new(FitOutputs { parameters_ron })),
-        comparison: None,
+        outputs: KindOutputs::Fit(Box::new(FitOutputs { parameters_ron }), chart),
         convergence: None,
     })
 }

@@ -81,16 +81,33 @@ pub struct Simulated {
     pub warnings: Vec<String>,
     /// The failure that ended the run early.
     pub failure: Option<String>,
-    /// A chart drawn instead of the final state's views (the virtual KES tests: the loop).
-    pub chart: Option<Chart>,
-    /// The series, charts and second run of a wet scene.
-    pub wet: Option<Box<WetOutputs>>,
-    /// The fitted parameters of a string identification.
-    pub fit: Option<Box<FitOutputs>>,
-    /// The compared run of a wet scene.
-    pub comparison: Option<Comparison>,
+    /// What the run adds by scene kind (a chart, a wet scene's series, a fit's parameters).
+    pub outputs: KindOutputs,
     /// Whether the steps converged (`None`: no solver stepped, the string identification).
     pub convergence: Option<Convergence>,
+}
+
+/// What a run adds to the cloth's frames, by scene kind.
+#[derive(Clone, Debug)]
+pub enum KindOutputs {
+    /// Nothing: the final state's views are the pictures (garments, drapes, strips).
+    Cloth,
+    /// A virtual KES test: its loop, drawn instead of the final state's views.
+    Chart(Chart),
+    /// A wet scene: its series and charts, and the compared run's cost if there was one.
+    Wet(Box<WetOutputs>, Option<Comparison>),
+    /// A string identification: its fitted parameters and the shapes' chart (no cloth).
+    Fit(Box<FitOutputs>, Chart),
+}
+
+impl Simulated {
+    /// The compared run of a wet scene.
+    pub fn comparison(&self) -> Option<&Comparison> {
+        match &self.outputs {
+            KindOutputs::Wet(_, c) => c.as_ref(),
+            _ => None,
+        }
+    }
 }
 
 /// What a wet run adds to the usual outputs: the series, charts and the compared run's final

@@ -182,7 +182,7 @@ impl Report {
             failure: sim.failure.clone(),
             convergence: sim.convergence.clone(),
             outputs: Vec::new(),
-            comparison: sim.comparison.clone(),
+            comparison: sim.comparison().cloned(),
             tryon: None,
         }
     }

@@ -15,7 +15,7 @@ use crate::chart::{Chart, Series};
 use crate::convergence::Convergence;
 use crate::export::Animation;
 pub use crate::outcome::WetOutputs;
-use crate::outcome::{Comparison, RunError, Simulated};
+use crate::outcome::{Comparison, KindOutputs, RunError, Simulated};
 pub use crate::scenario::wet::{METRICS, WetSpec};
 use crate::simulation::Timings;
 
@@ -213,10 +213,7 @@ pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> 
             .failure
             .as_ref()
             .map(|f| format!("t = {:.4} s: {}", f.time, f.error)),
-        chart: None,
-        wet: Some(Box::new(wet)),
-        fit: None,
-        comparison,
+        outputs: KindOutputs::Wet(Box::new(wet), comparison),
         convergence: Some(convergence(&main)),
     })
 }

@@ -24,7 +24,7 @@ use nalgebra::Vector3;
 
 use crate::convergence::UNCONVERGED_FRACTION;
 use crate::export::{Animation, FrameSelection};
-pub use crate::outcome::{RunError, Simulated, Solid};
+pub use crate::outcome::{KindOutputs, RunError, Simulated, Solid};
 use crate::pipeline::run_garment;
 use crate::report::Report;
 pub use crate::report::check_expectations;
@@ -396,10 +396,7 @@ fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
         metrics,
         warnings,
         failure: run.failure,
-        chart: None,
-        wet: None,
-        fit: None,
-        comparison: None,
+        outputs: KindOutputs::Cloth,
         convergence: Some(run.convergence),
     }
 }

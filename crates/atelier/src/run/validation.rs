@@ -13,7 +13,7 @@ use nalgebra::Vector3;
 use super::to_y_up;
 use crate::convergence::{Convergence, Tally, solvers};
 use crate::export::Animation;
-use crate::outcome::{RunError, Simulated, Solid};
+use crate::outcome::{KindOutputs, RunError, Simulated, Solid};
 use crate::scenario::{
     CantileverSpec, CatenarySpec, DrapeSpec, KesBendingSpec, KesTensileSpec, StripDirection, Tester,
 };
@@ -138,10 +138,7 @@ impl Stepper {
             metrics,
             warnings: Vec::new(),
             failure: self.failure,
-            chart: None,
-            wet: None,
-            fit: None,
-            comparison: None,
+            outputs: KindOutputs::Cloth,
             convergence: Some(self.tally.convergence(self.tolerance)),
         }
     }
@@ -689,10 +686,7 @@ fn kes_simulated(
         metrics,
         warnings: Vec::new(),
         failure: None,
-        chart: Some(chart),
-        wet: None,
-        fit: None,
-        comparison: None,
+        outputs: KindOutputs::Chart(chart),
         convergence: Some(Convergence::from_stats(solvers::PARTY, stats)),
     })
 }

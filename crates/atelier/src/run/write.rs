@@ -7,7 +7,7 @@ use super::{PictureStyle, RunOptions, outputs};
 use crate::export::{
     Animation, ExportError, GlbOptions, MeshPart, write_glb, write_obj, write_ply,
 };
-use crate::outcome::{RunError, Simulated};
+use crate::outcome::{KindOutputs, RunError, Simulated};
 
 /// Colour of the cloth in exports and pictures.
 const CLOTH_COLOUR: [f32; 3] = [0.85, 0.35, 0.25];
@@ -24,7 +24,7 @@ pub(super) fn write_outputs(
 ) -> Result<(Vec<String>, Vec<String>), RunError> {
     let mut written = Vec::new();
     let mut warnings = Vec::new();
-    if let Some(fit) = &sim.fit {
+    if let KindOutputs::Fit(fit, chart) = &sim.outputs {
         // A string identification: its parameters and the shapes' chart, no cloth.
         let (w, h) = options.picture;
         let io = |path: PathBuf| move |source| RunError::Output { path, source };
@@ -32,17 +32,15 @@ pub(super) fn write_outputs(
         atelier_files::files::write_atomic(&path, fit.parameters_ron.as_bytes())
             .map_err(io(path))?;
         written.push(outputs::PARAMETERS.into());
-        if let Some(chart) = &sim.chart {
-            let size = (2 * w as u32, h as u32);
-            write_chart(
-                out,
-                outputs::PICTURE,
-                chart,
-                size,
-                &mut written,
-                &mut warnings,
-            )?;
-        }
+        let size = (2 * w as u32, h as u32);
+        write_chart(
+            out,
+            outputs::PICTURE,
+            chart,
+            size,
+            &mut written,
+            &mut warnings,
+        )?;
         return Ok((written, warnings));
     }
     let Some(final_cloth) = sim.cloth.last() else {
@@ -89,7 +87,7 @@ pub(super) fn write_outputs(
     )?;
 
     let (w, h) = options.picture;
-    if let Some(wet) = &sim.wet {
+    if let KindOutputs::Wet(wet, _) = &sim.outputs {
         write_wet_outputs(
             wet,
             &sim.cloth_triangles,
@@ -119,8 +117,8 @@ pub(super) fn write_outputs(
         }
         _ => draw(&|p| *p, w, h),
     };
-    match &sim.chart {
-        Some(chart) if crate::chart::DRAWN => {
+    match &sim.outputs {
+        KindOutputs::Chart(chart) if crate::chart::DRAWN => {
             let size = (2 * w as u32, h as u32);
             write_chart(
                 out,
