@@ -341,7 +341,9 @@ pub struct DrapeRun {
     pub trace: Vec<DrapeSample>,
 }
 
-fn rms_speed(cloth: &Cloth, state: &ClothState) -> f64 {
+/// Mass-weighted root-mean-square speed of the free (unpinned) nodes, m/s: the rest test of the
+/// drape scenes and the validation scenes.
+pub fn rms_speed(cloth: &Cloth, state: &ClothState) -> f64 {
     let (mut e, mut m) = (0.0, 0.0);
     for (i, (v, mass)) in state.velocities.iter().zip(cloth.masses()).enumerate() {
         if !cloth.is_pinned(i) {

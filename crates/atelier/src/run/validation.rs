@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::scenes::DrapeScene;
+use atelier_solver::scenes::{DrapeScene, rms_speed};
 use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
 use nalgebra::Vector3;
 
@@ -142,18 +142,6 @@ impl Stepper {
             convergence: Some(self.tally.convergence(self.tolerance)),
         }
     }
-}
-
-/// RMS speed of the free nodes, mass-weighted, m/s (the drape's rest test).
-fn rms_speed(cloth: &Cloth, state: &ClothState) -> f64 {
-    let (mut e, mut m) = (0.0, 0.0);
-    for (i, (v, mass)) in state.velocities.iter().zip(cloth.masses()).enumerate() {
-        if !cloth.is_pinned(i) {
-            e += mass * v.norm_squared();
-            m += mass;
-        }
-    }
-    if m > 0.0 { (e / m).sqrt() } else { 0.0 }
 }
 
 pub(super) fn drape(
