@@ -11,7 +11,8 @@
 //!   [`convergence`]), exports ([`export`]: OBJ, PLY, glTF) and pictures ([`picture`], the one
 //!   rasteriser; [`camera`]; [`chart`], drawn only with the `charts` feature).
 //! - Virtual tests and the other scene kinds run through the same runner: wet cloth ([`wet`]),
-//!   string identification ([`fit`]) and the turned strip ([`strip`]).
+//!   string identification and the writing of a fabric's bending fit ([`fit`]; the fits
+//!   themselves, and the turned strip, are `atelier-fit`'s).
 //!
 //! The command-line program is the `atelier-cli` crate; the try-on from a photograph is
 //! `atelier-tryon`. A library user depends on this crate alone and pulls neither clap,
@@ -33,7 +34,6 @@ pub mod scenario;
 pub mod scene;
 pub mod sewing;
 pub mod simulation;
-pub mod strip;
 pub mod wet;
 
 pub use assemble::{AssembleError, GarmentCloth};

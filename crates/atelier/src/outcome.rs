@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::chart::Chart;
-use atelier_fabric::FileError;
+use atelier_files::{ErrorKind, FileError, InvalidValue};
 
 use crate::convergence::Convergence;
 use crate::export::Animation;
@@ -28,9 +28,17 @@ pub enum RunError {
     #[error(transparent)]
     Scene(#[from] SceneError),
     /// Another scene kind could not be set up (a parameter out of range, a grid or cloth that
-    /// cannot be built); the message says which scene and why.
-    #[error("{0}")]
-    Setup(String),
+    /// cannot be built): the scene and why.
+    #[error("{scene}: {source}")]
+    Setup {
+        /// The scene (`cantilever`, `wet scene`, `string fit`, …).
+        scene: &'static str,
+        /// Why (boxed: the crates' errors are large and a run returns this on every path).
+        source: Box<SetupError>,
+    },
+    /// `atelier fit`: the observations could not be fitted.
+    #[error(transparent)]
+    FabricFit(#[from] atelier_fit::fabric_fit::FabricFitError),
     /// The output folder could not be created or written.
     #[error("cannot write {}: {source}", path.display())]
     Output {
@@ -40,6 +48,61 @@ pub enum RunError {
         #[source]
         source: std::io::Error,
     },
+}
+
+impl RunError {
+    /// A [`RunError::Setup`] of `scene`, as a `map_err` argument.
+    pub fn setup<E: Into<SetupError>>(scene: &'static str) -> impl Fn(E) -> Self {
+        move |e| Self::Setup {
+            scene,
+            source: Box::new(e.into()),
+        }
+    }
+
+    /// A [`RunError::Setup`] of `scene`: `field` out of range, `message` naming the value.
+    pub fn out_of_range(
+        scene: &'static str,
+        field: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Self::setup(scene)(InvalidValue::new(ErrorKind::OutOfRange, field, message))
+    }
+}
+
+/// Why a scene kind other than the garment could not be set up: the typed error of the crate
+/// that refused it.
+#[derive(Debug, thiserror::Error)]
+pub enum SetupError {
+    /// A setting out of range (the field and the value).
+    #[error(transparent)]
+    Invalid(#[from] InvalidValue),
+    /// The step parameters.
+    #[error(transparent)]
+    Params(#[from] atelier_solver::ParamError),
+    /// The grid.
+    #[error(transparent)]
+    Topology(#[from] atelier_grid::TopologyError),
+    /// The cloth or a pin.
+    #[error(transparent)]
+    Cloth(#[from] atelier_solver::ClothError),
+    /// The drape tester.
+    #[error(transparent)]
+    Drape(#[from] atelier_solver::scenes::SceneError),
+    /// A virtual KES instrument.
+    #[error(transparent)]
+    Kes(#[from] atelier_solver::kes::KesError),
+    /// The wet scene.
+    #[error(transparent)]
+    Wet(#[from] atelier_solver::wet::scene::WetError),
+    /// The string model or its fit.
+    #[error(transparent)]
+    Fit(#[from] atelier_fit::FitError),
+    /// The turned strip.
+    #[error(transparent)]
+    Strip(#[from] atelier_fit::strip::StripError),
+    /// A result could not be serialised.
+    #[error("writing the result: {0}")]
+    Write(#[from] ron::Error),
 }
 
 /// A fixed part drawn and exported with the cloth: the body, or a drape tester's support.

@@ -397,9 +397,12 @@ pub enum SceneError {
     /// A setting is out of range.
     #[error("{0}")]
     Invalid(#[from] InvalidValue),
-    /// The body or the contact could not be set up.
-    #[error("{0}")]
-    Body(String),
+    /// The body's contact could not be set up.
+    #[error(transparent)]
+    Contact(#[from] atelier_collide::ContactError),
+    /// The body's parts could not be set up as rigid colliders.
+    #[error("body: {0}")]
+    Parts(#[from] atelier_collide::parts::PartsError),
 }
 
 impl Garment {

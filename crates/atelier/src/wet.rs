@@ -115,26 +115,28 @@ fn z_up(r: &WetRun) -> Vec<[f64; 3]> {
 
 /// Run a wet scenario: the main run (its frames recorded), then the compared run if any.
 pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> {
-    let setup = |e: String| RunError::Setup(format!("wet scene: {e}"));
+    const SCENE: &str = "wet scene";
     if !(spec.frame_interval > 0.0 && spec.frame_interval.is_finite()) {
-        return Err(setup(format!(
-            "`frame_interval` = {} is outside (0, ∞)",
-            spec.frame_interval
-        )));
+        return Err(RunError::out_of_range(
+            SCENE,
+            "frame_interval",
+            format!("{} is outside (0, ∞)", spec.frame_interval),
+        ));
     }
     if !(spec.fold_radius > 0.0 && spec.fold_radius < spec.scene.size) {
-        return Err(setup(format!(
-            "`fold_radius` = {} is outside (0, size)",
-            spec.fold_radius
-        )));
+        return Err(RunError::out_of_range(
+            SCENE,
+            "fold_radius",
+            format!("{} is outside (0, size)", spec.fold_radius),
+        ));
     }
     let scene = WetScene {
         frame_interval: Some(spec.frame_interval),
         ..spec.scene.clone()
     };
-    let main = run(&scene, fabric, &spec.solver).map_err(|e| setup(e.to_string()))?;
+    let main = run(&scene, fabric, &spec.solver).map_err(RunError::setup(SCENE))?;
     let compared = match &spec.compare {
-        Some(solver) => Some(run(&spec.scene, fabric, solver).map_err(|e| setup(e.to_string()))?),
+        Some(solver) => Some(run(&spec.scene, fabric, solver).map_err(RunError::setup(SCENE))?),
         None => None,
     };
     let mut metrics = run_metrics(&main, spec);

@@ -274,3 +274,52 @@ fn a_garment_larger_than_the_body_falls_off_and_says_so() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A setting a scene kind checks only when it runs is refused as a typed error naming the
+/// scene and the field: a wet scene's `fold_radius` beyond the sheet, a string fit observing
+/// more shapes than there are.
+#[test]
+fn a_scene_setting_out_of_range_names_the_scene_and_the_field() {
+    use atelier::outcome::{RunError, SetupError};
+    use atelier::scenario::{Scenario, ScenarioKind};
+    let load = |name: &str| {
+        Scenario::load(&root().join(format!("fixtures/scenarios/{name}.ron"))).expect("scenario")
+    };
+    let ScenarioKind::Wet(mut spec) = load("wet_pinch1_dry").kind else {
+        panic!("a wet scenario")
+    };
+    spec.fold_radius = 2.0 * spec.scene.size;
+    let fabric =
+        atelier_fabric::Fabric::load(&root().join("fixtures/scenarios").join(&spec.fabric))
+            .expect("fabric");
+    let e = atelier::wet::simulate(&spec, &fabric).expect_err("refused");
+    let RunError::Setup {
+        scene: "wet scene",
+        source,
+    } = &e
+    else {
+        panic!("not a wet scene's setup: {e:?}")
+    };
+    let SetupError::Invalid(v) = source.as_ref() else {
+        panic!("not a wet scene's invalid value: {e:?}")
+    };
+    assert_eq!(v.field, "fold_radius", "{e}");
+    assert_eq!(v.kind, ErrorKind::OutOfRange, "{e}");
+    assert!(e.to_string().starts_with("wet scene: "), "{e}");
+    let ScenarioKind::StringFit(mut spec) = load("fit_cable_j4").kind else {
+        panic!("a string-fit scenario")
+    };
+    spec.observed = 1000;
+    let e = atelier::fit::simulate(&spec, &root().join("fixtures/scenarios")).expect_err("refused");
+    let RunError::Setup {
+        scene: "string fit",
+        source,
+    } = &e
+    else {
+        panic!("not a string fit's setup: {e:?}")
+    };
+    let SetupError::Invalid(v) = source.as_ref() else {
+        panic!("not a string fit's invalid value: {e:?}")
+    };
+    assert_eq!(v.field, "observed", "{e}");
+}

@@ -7,10 +7,10 @@ use std::path::PathBuf;
 
 use atelier::scenario::Scenario;
 use atelier::scenario::StripDirection;
-use atelier::strip::{TurnedRun, turned_strip};
 use atelier_fabric::Fabric;
 use atelier_files::noise::Rng;
 use atelier_fit::cloth::{ProfilePoint, fit_cantilever};
+use atelier_fit::strip::{TurnedRun, turned_strip};
 use atelier_fit::turned::{TurnedProfile, fit_turned};
 
 fn root() -> PathBuf {
@@ -198,7 +198,7 @@ fn atelier_fit_writes_a_fabric_with_the_fitted_rigidity() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The turned strip of `fabric` along the warp or weft (`atelier::strip`, the default run but
+/// The turned strip of `fabric` along the warp or weft (`atelier_fit::strip`, the default run but
 /// `segments` cells), overhanging by 3·c of its direction (the experimenter's choice, long
 /// enough that most of the strip is loaded beyond M₀/B; the fit is given only the overhang),
 /// observed at `angles`.
@@ -337,7 +337,7 @@ fn bending_hysteresis_is_recovered_from_a_turned_cantilever() {
     }
 }
 
-/// The solver's own B and M₀ (`atelier::strip::fit_turned_party`: the turned strip in the
+/// The solver's own B and M₀ (`atelier_fit::strip::fit_turned_party`: the turned strip in the
 /// PARTY solver as the forward model, started from the continuum fit) from turned strips
 /// observed at 16 cells and fitted at 10 — a different discretisation, so the fit cannot
 /// simply replay its observations. Measured (session 8, the quasi-static instrument): wool
@@ -346,7 +346,7 @@ fn bending_hysteresis_is_recovered_from_a_turned_cantilever() {
 /// noise within the same bounds.
 #[test]
 fn the_solver_hysteresis_is_recovered_through_the_solver() {
-    use atelier::strip::fit_turned_party;
+    use atelier_fit::strip::fit_turned_party;
     let angles = [0.0, 90.0, 180.0];
     let run = TurnedRun::default();
     for (name, weft) in STRIPS {

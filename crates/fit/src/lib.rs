@@ -13,11 +13,13 @@ pub mod cloth;
 pub mod differenced;
 pub mod error;
 pub mod experiment;
+pub mod fabric_fit;
 pub mod identify;
 pub mod observation;
 pub mod rod;
 pub mod statics;
 pub mod string;
+pub mod strip;
 pub mod synthetic;
 pub mod turned;
 

@@ -163,14 +163,12 @@ pub(super) fn drape(
     scene.cloth_options.form = spec.form;
     let (cloth, mut state) = scene
         .build(fabric)
-        .map_err(|e| RunError::Setup(format!("drape scene: {e}")))?;
+        .map_err(RunError::setup("drape scene"))?;
     let params = StepParams {
         dt: spec.dt.unwrap_or(dt),
         ..spec.step.clone()
     };
-    params
-        .validate()
-        .map_err(|e| RunError::Setup(format!("drape scene: {e}")))?;
+    params.validate().map_err(RunError::setup("drape scene"))?;
     // The rest criterion of `run_drape` (RestCriterion::default()).
     let stop = atelier_solver::scenes::RestCriterion::default();
     let eps = 1e-9 * params.dt;
@@ -314,16 +312,16 @@ pub(super) fn cantilever(
         // Warp across the strip (along pattern x): the strip runs along the weft.
         grid.grain_angle = 0.0;
     }
-    let setup = |e: String| RunError::Setup(format!("cantilever: {e}"));
-    let topo = ClothTopology::from_structured(&grid).map_err(|e| setup(e.to_string()))?;
+    const SCENE: &str = "cantilever";
+    let topo = ClothTopology::from_structured(&grid).map_err(RunError::setup(SCENE))?;
     let mut cloth =
-        Cloth::new(topo, fabric, AnisotropyForm::Thesis).map_err(|e| setup(e.to_string()))?;
+        Cloth::new(topo, fabric, AnisotropyForm::Thesis).map_err(RunError::setup(SCENE))?;
     let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
     for node in 0..4 {
         let p = place(cloth.topology().rest_positions()[node]);
         cloth
             .pin(node as u32, p, PinMotion::Fixed)
-            .map_err(|e| setup(e.to_string()))?;
+            .map_err(RunError::setup(SCENE))?;
     }
     let mut state = ClothState::placed(&cloth, place);
     // Implicit bending keeps this stable up to about 0.4·h s/m; 0.25·h leaves a margin.
@@ -333,7 +331,7 @@ pub(super) fn cantilever(
         hysteresis: spec.hysteresis,
         ..StepParams::default()
     };
-    params.validate().map_err(|e| setup(e.to_string()))?;
+    params.validate().map_err(RunError::setup(SCENE))?;
     let mut stepper = Stepper::new(&state, spec.frame_interval);
     let mut solver = Solver::new();
     let mut at_rest = false;
@@ -406,12 +404,12 @@ pub(super) fn catenary(
     progress: &mut dyn FnMut(f64),
 ) -> Result<Simulated, RunError> {
     let (length, span, segments) = (spec.length, spec.span, spec.segments);
-    let setup = |e: String| RunError::Setup(format!("catenary: {e}"));
+    const SCENE: &str = "catenary";
     let topo =
         ClothTopology::from_structured(&StructuredGrid::sheet(segments + 1, 2, length, 0.01))
-            .map_err(|e| setup(e.to_string()))?;
+            .map_err(RunError::setup(SCENE))?;
     let mut cloth =
-        Cloth::new(topo, fabric, AnisotropyForm::Thesis).map_err(|e| setup(e.to_string()))?;
+        Cloth::new(topo, fabric, AnisotropyForm::Thesis).map_err(RunError::setup(SCENE))?;
     let a = catenary_parameter(span, length);
     let (mut lo, mut hi) = (1e-6_f64, std::f64::consts::PI - 1e-9);
     for _ in 0..200 {
@@ -435,7 +433,7 @@ pub(super) fn catenary(
             let p = place(cloth.topology().rest_positions()[node]);
             cloth
                 .pin(node as u32, p, PinMotion::Fixed)
-                .map_err(|e| setup(e.to_string()))?;
+                .map_err(RunError::setup(SCENE))?;
         }
     }
     let mut state = ClothState::placed(&cloth, place);
@@ -445,7 +443,7 @@ pub(super) fn catenary(
         bending_off: true,
         ..StepParams::default()
     };
-    params.validate().map_err(|e| setup(e.to_string()))?;
+    params.validate().map_err(RunError::setup(SCENE))?;
     let mut stepper = Stepper::new(&state, spec.frame_interval);
     let mut solver = Solver::new();
     let steps = (spec.duration / spec.dt).round() as usize;
@@ -492,12 +490,12 @@ fn kes_frames(start: Vec<[f64; 3]>, end: &ClothState, time: f64) -> Animation {
 pub(super) fn kes_tensile(spec: &KesTensileSpec, fabric: &Fabric) -> Result<Simulated, RunError> {
     use atelier_fabric::{TensileState, units};
     use atelier_solver::kes;
-    let setup = |e: String| RunError::Setup(format!("KES tensile test: {e}"));
+    const SCENE: &str = "KES tensile test";
     let path = kes::cycle(units::force_from_kes(spec.max_force_gf_cm), spec.levels);
     let form = AnisotropyForm::Thesis;
     let clock = Instant::now();
     let curve = kes::tensile_test(fabric, form, spec.direction, &path, 3)
-        .map_err(|e| setup(e.to_string()))?;
+        .map_err(RunError::setup(SCENE))?;
     let wall = clock.elapsed().as_secs_f64();
     let input_loop = match spec.direction {
         StripDirection::Warp => &fabric.tensile.warp,
@@ -572,7 +570,7 @@ pub(super) fn kes_tensile(spec: &KesTensileSpec, fabric: &Fabric) -> Result<Simu
 pub(super) fn kes_bending(spec: &KesBendingSpec, fabric: &Fabric) -> Result<Simulated, RunError> {
     use atelier_fabric::units;
     use atelier_solver::kes;
-    let setup = |e: String| RunError::Setup(format!("KES bending test: {e}"));
+    const SCENE: &str = "KES bending test";
     let clock = Instant::now();
     let curve = kes::bending_test(
         fabric,
@@ -580,7 +578,7 @@ pub(super) fn kes_bending(spec: &KesBendingSpec, fabric: &Fabric) -> Result<Simu
         spec.direction,
         spec.steps_per_leg,
     )
-    .map_err(|e| setup(e.to_string()))?;
+    .map_err(RunError::setup(SCENE))?;
     let wall = clock.elapsed().as_secs_f64();
     let spindle = match spec.direction {
         StripDirection::Warp => &fabric.bending.warp,

@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 use atelier_body::kinematics::Posed;
 use atelier_body::model::LabelledMesh;
 use atelier_collide::parts::Motion as PartMotion;
-use atelier_collide::{ContactMaterial, ContactParams, RigidParts, V3};
+use atelier_collide::{ContactError, ContactMaterial, ContactParams, RigidParts, V3};
 use atelier_solver::baselines::{MassSpring, Xpbd};
 use atelier_solver::integrator::{Integrator, MassSpringIntegrator, StepInput, XpbdIntegrator};
 use atelier_solver::{
@@ -100,7 +100,7 @@ pub enum Failure {
     Step(#[from] StepError),
     /// The body stage: the motion gave a pose the contact refused (a non-finite part motion).
     #[error("body stage: {0}")]
-    Body(String),
+    Body(ContactError),
 }
 
 /// What one step did.
@@ -205,8 +205,7 @@ impl Simulation {
             one_sided,
             ..ContactParams::default()
         };
-        let mut contact = BodyContact::new(&g.cloth.cloth, contact_params)
-            .map_err(|e| SceneError::Body(e.to_string()))?;
+        let mut contact = BodyContact::new(&g.cloth.cloth, contact_params)?;
         if settings.self_collision {
             // The two sides of a seam are one point of the garment: they never collide.
             contact.set_cloth_groups(seam_groups(
@@ -221,8 +220,7 @@ impl Simulation {
             .iter()
             .map(|p| (p.vertices.as_slice(), p.triangles.as_slice()))
             .collect();
-        let parts =
-            RigidParts::new(&part_meshes).map_err(|e| SceneError::Body(format!("body: {e}")))?;
+        let parts = RigidParts::new(&part_meshes)?;
         // The continuous test needs only the faces on the body's surface: a face buried in
         // another part (the parts overlap at the joints) can only be met from inside.
         let surface_triangles = exposed_triangles(&scene.body.mannequin, &rest, &parts);
@@ -233,9 +231,7 @@ impl Simulation {
         // the body and is left as laid out.
         if !one_sided {
             let mut at_start = parts;
-            at_start
-                .set_motion(&start_pose, &start_pose, settings.dt)
-                .map_err(|e| SceneError::Body(e.to_string()))?;
+            at_start.set_motion(&start_pose, &start_pose, settings.dt)?;
             let out = 2.0 * settings.skin;
             for x in &mut state.positions {
                 if let Some(n) = at_start.nearest(x, settings.skin, false) {
@@ -247,18 +243,14 @@ impl Simulation {
         } else {
             contact.set_parts(parts);
         }
-        contact
-            .set_body(
-                &posed.positions,
-                &posed.positions,
-                &surface_triangles,
-                settings.dt,
-            )
-            .map_err(|e| SceneError::Body(e.to_string()))?;
+        contact.set_body(
+            &posed.positions,
+            &posed.positions,
+            &surface_triangles,
+            settings.dt,
+        )?;
         // Standing: the same pose at both ends of the step.
-        contact
-            .set_part_motion(&start_pose, &start_pose, settings.dt)
-            .map_err(|e| SceneError::Body(e.to_string()))?;
+        contact.set_part_motion(&start_pose, &start_pose, settings.dt)?;
         let params = StepParams {
             dt: settings.dt,
             gravity: [0.0; 3],
@@ -570,7 +562,7 @@ impl Simulation {
                     self.contact
                         .set_part_motion(&self.motion_start, &self.motion_end, h)
                 })
-                .map_err(|e| Failure::Body(e.to_string()))?;
+                .map_err(Failure::Body)?;
             timings.body += clock.elapsed();
         }
         self.params.dt = h;

@@ -9,14 +9,63 @@
 //! centreline's free points in the fixed frame (x forward, droop downwards).
 
 use atelier_fabric::{AnisotropyForm, Fabric, Spindle};
-use atelier_fit::cloth::ProfilePoint;
-use atelier_fit::turned::{TurnedProfile, minimise};
-use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+use atelier_files::{ErrorKind, InvalidValue};
+use atelier_grid::{ClothTopology, StructuredGrid, TopologyError};
+use atelier_solver::kes::Direction as StripDirection;
+use atelier_solver::{
+    Cloth, ClothError, ClothState, ParamError, PinMotion, Solver, StepError, StepParams,
+};
 use nalgebra::{DVector, Vector3};
 
-use crate::outcome::RunError;
-use crate::scenario::StripDirection;
+use crate::cloth::ProfilePoint;
+use crate::turned::{TurnedProfile, minimise};
+
+/// Why the turned strip could not be run or fitted.
+#[derive(Debug, thiserror::Error)]
+pub enum StripError {
+    /// An argument out of range (the overhang, the cell count, a clamp angle).
+    #[error(transparent)]
+    Invalid(#[from] InvalidValue),
+    /// The strip's grid could not be built.
+    #[error(transparent)]
+    Topology(#[from] TopologyError),
+    /// The strip's cloth or its clamp could not be built.
+    #[error(transparent)]
+    Cloth(#[from] ClothError),
+    /// The step parameters are out of range.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    /// A step failed (the stage and node are in the source).
+    #[error("at {clamp_deg:.1}°: {source}")]
+    Step {
+        /// The clamp's angle when it failed, degrees.
+        clamp_deg: f64,
+        /// The step's error.
+        source: StepError,
+    },
+    /// A hold ran out of time before the strip came to rest.
+    #[error(
+        "not at rest {max_hold:.0} s after turning to {clamp_deg:.1}° (fastest node {fastest:.2e} m/s)"
+    )]
+    NotAtRest {
+        /// The longest hold, s.
+        max_hold: f64,
+        /// The clamp's angle, degrees.
+        clamp_deg: f64,
+        /// The fastest node's speed at the end of the hold, m/s.
+        fastest: f64,
+    },
+    /// The fit's first strip did not come to rest.
+    #[error(
+        "the solver's strip does not come to rest at the start B {rigidity:.3e} N·m, M₀ {residual_moment:.3e} N"
+    )]
+    Start {
+        /// B, N·m.
+        rigidity: f64,
+        /// M₀, N.
+        residual_moment: f64,
+    },
+}
 
 /// How the turned strip is run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,20 +113,32 @@ pub fn turned_strip(
     overhang: f64,
     angles: &[f64],
     run: &TurnedRun,
-) -> Result<Vec<TurnedProfile>, RunError> {
-    let setup = |e: String| RunError::Setup(format!("turned strip: {e}"));
-    if !(overhang.is_finite() && overhang > 0.0) || run.segments < 4 {
-        return Err(setup(format!(
-            "overhang {overhang} m and {} cells: need a positive overhang and at least 4 cells",
-            run.segments
-        )));
+) -> Result<Vec<TurnedProfile>, StripError> {
+    if !(overhang.is_finite() && overhang > 0.0) {
+        return Err(InvalidValue::new(
+            ErrorKind::OutOfRange,
+            "overhang",
+            format!("{overhang} m: need a positive overhang"),
+        )
+        .into());
+    }
+    if run.segments < 4 {
+        return Err(InvalidValue::new(
+            ErrorKind::OutOfRange,
+            "segments",
+            format!("{} cells: need at least 4", run.segments),
+        )
+        .into());
     }
     let mut last = 0.0;
-    for &a in angles {
+    for (k, &a) in angles.iter().enumerate() {
         if !(a.is_finite() && (last..=180.0).contains(&a)) {
-            return Err(setup(format!(
-                "clamp angle {a}°: angles must rise from 0 to at most 180"
-            )));
+            return Err(InvalidValue::new(
+                ErrorKind::OutOfRange,
+                format!("angles[{k}]"),
+                format!("{a}°: angles must rise from 0 to at most 180"),
+            )
+            .into());
         }
         last = a;
     }
@@ -89,18 +150,15 @@ pub fn turned_strip(
         // Warp across the strip: the strip runs along the weft.
         grid.grain_angle = 0.0;
     }
-    let topo = ClothTopology::from_structured(&grid).map_err(|e| setup(e.to_string()))?;
-    let mut cloth =
-        Cloth::new(topo, fabric, AnisotropyForm::Thesis).map_err(|e| setup(e.to_string()))?;
+    let topo = ClothTopology::from_structured(&grid)?;
+    let mut cloth = Cloth::new(topo, fabric, AnisotropyForm::Thesis)?;
     let place = |[x, y]: [f64; 2]| Vector3::new(y - 0.5 * h, x, 0.0);
     let rest = cloth.topology().rest_positions()[..4].to_vec();
-    let clamp = |cloth: &mut Cloth, beta: f64| -> Result<(), RunError> {
+    let clamp = |cloth: &mut Cloth, beta: f64| -> Result<(), StripError> {
         for (node, &r) in rest.iter().enumerate() {
             let p = place(r);
             let q = Vector3::new(p.x * beta.cos(), p.y, -p.x * beta.sin());
-            cloth
-                .pin(node as u32, q, PinMotion::Fixed)
-                .map_err(|e| setup(e.to_string()))?;
+            cloth.pin(node as u32, q, PinMotion::Fixed)?;
         }
         Ok(())
     };
@@ -113,7 +171,7 @@ pub fn turned_strip(
         implicit_stick_slope: true,
         ..StepParams::default()
     };
-    params.validate().map_err(|e| setup(e.to_string()))?;
+    params.validate()?;
     let g = params.gravity;
     let mut solver = Solver::new();
     let rate = run.rate_deg_s.to_radians();
@@ -131,7 +189,10 @@ pub fn turned_strip(
             }
             solver
                 .step(&cloth, &mut state, &params)
-                .map_err(|e| setup(format!("at {:.1}°: {e}", beta.to_degrees())))?;
+                .map_err(|source| StripError::Step {
+                    clamp_deg: beta.to_degrees(),
+                    source,
+                })?;
             let fastest = state
                 .velocities
                 .iter()
@@ -141,11 +202,11 @@ pub fn turned_strip(
                 break;
             }
             if state.time - start > run.max_hold {
-                return Err(setup(format!(
-                    "not at rest {:.0} s after turning to {:.1}° (fastest node {fastest:.2e} m/s)",
-                    run.max_hold,
-                    beta.to_degrees()
-                )));
+                return Err(StripError::NotAtRest {
+                    max_hold: run.max_hold,
+                    clamp_deg: beta.to_degrees(),
+                    fastest,
+                });
             }
         }
         let points = (1..nv)
@@ -245,7 +306,7 @@ fn along(line: &[(f64, f64, f64)], s: f64) -> (f64, f64) {
 
 /// Fit the solver's B and M₀ of `direction` (every other value of `base` kept) so that its
 /// turned strip (`run`) passes nearest the observed profiles; start from `start` (B, M₀) —
-/// the continuum strip's fit (`atelier_fit::turned::fit_turned`) is a good one.
+/// the continuum strip's fit ([`crate::turned::fit_turned`]) is a good one.
 /// Levenberg–Marquardt (the `levenberg-marquardt` crate) on (ln B, ln M₀).
 pub fn fit_turned_party(
     profiles: &[TurnedProfile],
@@ -254,7 +315,7 @@ pub fn fit_turned_party(
     direction: StripDirection,
     run: &TurnedRun,
     start: (f64, f64),
-) -> Result<PartyHysteresisFit, RunError> {
+) -> Result<PartyHysteresisFit, StripError> {
     let angles: Vec<f64> = profiles.iter().map(|p| p.clamp_deg).collect();
     let problem = PartyProblem {
         base,
@@ -266,12 +327,9 @@ pub fn fit_turned_party(
         runs: std::sync::atomic::AtomicUsize::new(0),
     };
     let start = DVector::from_vec(vec![start.0.ln(), start.1.ln()]);
-    let r0 = problem.residuals_at(&start).ok_or_else(|| {
-        RunError::Setup(format!(
-            "turned strip: the solver's strip does not come to rest at the start B {:.3e} N·m, M₀ {:.3e} N",
-            start[0].exp(),
-            start[1].exp()
-        ))
+    let r0 = problem.residuals_at(&start).ok_or(StripError::Start {
+        rigidity: start[0].exp(),
+        residual_moment: start[1].exp(),
     })?;
     let rows = r0.len() / 2;
     // Central differences of 1e-3 in (ln B, ln M₀).

@@ -1,10 +1,10 @@
 //! Probe (not a test): the turned strip of a fixture fabric through the PARTY solver, fitted by
 //! the continuum model, with the run's knobs on the command line:
-//! `cargo run --release -p atelier --example turned_probe -- silk warp 16 [rate °/s] [damping] [load s] [rest speed m/s]`.
-use atelier::scenario::StripDirection;
-use atelier::strip::{TurnedRun, turned_strip};
+//! `cargo run --release -p atelier-fit --example turned_probe -- silk warp 16 [rate °/s] [damping] [load s] [rest speed m/s]`.
 use atelier_fabric::Fabric;
+use atelier_fit::strip::{TurnedRun, turned_strip};
 use atelier_fit::turned::fit_turned;
+use atelier_solver::kes::Direction as StripDirection;
 use std::path::Path;
 
 fn main() {
