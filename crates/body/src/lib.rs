@@ -1,7 +1,9 @@
 //! # atelier-body
 //!
 //! The human body of the PARTY thesis (§2.4 (II), §4.6.2, §5.6): a surface of triangles split
-//! into 17 rigid parts in a tree with movable joints, driven by keyframed motion.
+//! into 17 rigid parts in a tree with movable joints, driven by keyframed motion; and its range
+//! images ([`range`]): the body gridded from front and back range images (§4.6.2, §4.7.2) and
+//! the range images of a posed mannequin rendered for it. The parts are [`part::Part`].
 
 pub mod articulate;
 pub mod build;
@@ -10,6 +12,7 @@ pub mod io;
 pub mod kinematics;
 pub mod model;
 pub mod motion;
+pub mod part;
 pub mod range;
 #[cfg(test)]
 mod testing;

@@ -2,11 +2,11 @@
 //! joined by joints with pivots and rotation limits, in the tree of [`Part::parent`] rooted at
 //! the pelvis.
 //!
-//! Frame (shared with `atelier_grid::range`): x towards the body's left, y up, z forward; metres.
+//! Frame (shared with the range images, [`crate::range`]): x towards the body's left, y up, z forward; metres.
 //! The rest pose stands upright with the arms slightly away from the torso (an A-pose) and the
 //! feet on the plane y = 0.
 
-pub use atelier_grid::range::Part;
+pub use crate::part::Part;
 
 /// 3-vector, m.
 pub type V3 = nalgebra::Vector3<f64>;

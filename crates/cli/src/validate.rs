@@ -112,7 +112,7 @@ pub fn validate(path: &Path) -> Outcome {
             atelier_body::Motion::load(p, &atelier_body::build::jis_9ar()).map(|_| ())
         }),
         (Kind::RangeSide, &|p| {
-            atelier_files::files::load_ron::<atelier_grid::range::SideFile>(p).map(|_| ())
+            atelier_files::files::load_ron::<atelier_body::range::SideFile>(p).map(|_| ())
         }),
         (Kind::TryonPose, &|p| {
             let pose: atelier_tryon::pose::PoseFile = atelier_files::files::load_ron(p)?;

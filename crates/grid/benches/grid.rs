@@ -1,7 +1,7 @@
 //! Benchmarks of the gridding: every panel of the eight-panel dress (parse excluded: the spec is
 //! read once; timed is the initial grid, constraints, improvement, quality and topology), and
-//! the whole garment file (parse, grid, seams); the synthetic mannequin's body gridded from its
-//! range images, and the error measurement.
+//! the whole garment file (parse, grid, seams). The body gridded from range images is benched in
+//! `atelier-body` (`benches/range.rs`).
 
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -43,22 +43,5 @@ fn panels(c: &mut Criterion) {
     group.finish();
 }
 
-fn body(c: &mut Criterion) {
-    use atelier_grid::range::synthetic::Mannequin;
-    use atelier_grid::range::{BodyGridParams, grid_body, measure_error};
-    let mut group = c.benchmark_group("grid_body");
-    group.sample_size(10);
-    let body = Mannequin::jis_9ar().body(2.5);
-    let (mesh, _) = grid_body(&body, &BodyGridParams::default()).expect("grids");
-    assert!(measure_error(&mesh, &body).total.mean_abs_mm <= 1.5);
-    group.bench_function("mannequin_2.5mm", |b| {
-        b.iter(|| grid_body(black_box(&body), &BodyGridParams::default()).expect("grids"));
-    });
-    group.bench_function("measure_error", |b| {
-        b.iter(|| measure_error(black_box(&mesh), &body));
-    });
-    group.finish();
-}
-
-criterion_group!(benches, panels, body);
+criterion_group!(benches, panels);
 criterion_main!(benches);

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use atelier_grid::range::synthetic::Mannequin;
-use atelier_grid::range::{BodyGridParams, BodyMesh, ErrorImage, Part, grid_body, measure_error};
+use atelier_body::range::synthetic::Mannequin;
+use atelier_body::range::{BodyGridParams, BodyMesh, ErrorImage, Part, grid_body, measure_error};
 use plotters::prelude::*;
 
 use crate::figures::plot::{blit, png};

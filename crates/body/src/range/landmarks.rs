@@ -1,5 +1,5 @@
-//! The 31 landmarks of [`atelier_grid::range::LANDMARKS`] on the front silhouette of a rendered
-//! body, found from the posed mesh and its part labels, the way `atelier_grid::range::synthetic`
+//! The 31 landmarks of [`super::LANDMARKS`] on the front silhouette of a rendered
+//! body, found from the posed mesh and its part labels, the way `super::synthetic`
 //! finds them on its analytic mannequin:
 //!
 //! - a **cut** between a parent part P and a child part C (chin, neck, waist, hip, elbow, wrist,
@@ -22,7 +22,7 @@
 
 use std::collections::BTreeMap;
 
-use atelier_grid::range::{LANDMARKS, Part, View};
+use super::{LANDMARKS, Part, View};
 
 use super::{NO_PART, RangeError, Views};
 use crate::model::LabelledMesh;

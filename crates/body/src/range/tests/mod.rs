@@ -1,18 +1,17 @@
 //! Reference values: exact depths of a box (axis-aligned and rotated) and a sphere within its
-//! chord error; agreement with `atelier_grid`'s analytic mannequin (its own renderer of the error
+//! chord error; agreement with the analytic mannequin ([`super::synthetic`]) (its own renderer of the error
 //! and its analytic landmarks); the round trip mannequin → range images → gridded body → error;
 //! files; typed errors.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use atelier_grid::range::{
-    BodyGridParams, BodyMesh, LANDMARKS, RangeBody, grid_body, measure_error, synthetic,
-};
+use super::{BodyGridParams, BodyMesh, LANDMARKS, RangeBody, grid_body, measure_error, synthetic};
 
+use super::Part;
 use super::*;
-use crate::model::{JointLimits, PartMesh, V3};
-use atelier_grid::range::Part;
+use crate::model::{JointLimits, LabelledMesh, Mannequin, PartMesh, V3};
+use std::time::Instant;
 
 /// A fresh temporary directory, removed on drop.
 struct TempDir(PathBuf);
@@ -120,5 +119,6 @@ fn sphere_mesh(centre: V3, radius: f64, nlat: usize, nlon: usize) -> LabelledMes
     m
 }
 
+mod from_images;
 mod round_trip;
 mod shapes;

@@ -1,4 +1,4 @@
-//! Agreement with `atelier_grid`'s analytic mannequin; the round trip mannequin → range images
+//! Agreement with the analytic mannequin (`range::synthetic`); the round trip mannequin → range images
 //! → gridded body → error, standing and walking; files; typed errors.
 
 use super::*;

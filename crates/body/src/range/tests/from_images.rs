@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use atelier_files::ErrorKind;
 
-use super::synthetic::Mannequin;
-use super::*;
+use crate::range::synthetic::Mannequin;
+use crate::range::*;
 
 /// A fresh temporary directory, removed on drop.
 struct TempDir(PathBuf);

@@ -5,7 +5,7 @@
 
 use super::body::RangeBody;
 use super::gridding::BodyMesh;
-use super::part::Part;
+use crate::part::Part;
 
 /// Error statistics of one part or of the whole body.
 #[derive(Clone, Copy, Debug, PartialEq)]

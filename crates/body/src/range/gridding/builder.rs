@@ -4,12 +4,12 @@
 
 use std::collections::HashMap;
 
-use crate::coons::{arc_lengths, coons, resample};
-use crate::improve::{Surface, improve};
-use crate::patch::Patch;
+use atelier_grid::coons::{arc_lengths, coons, resample};
+use atelier_grid::improve::{Surface, improve};
+use atelier_grid::patch::Patch;
 
+use crate::part::Part;
 use crate::range::field::{DepthField, Layer};
-use crate::range::part::Part;
 use crate::range::side::View;
 
 use super::{BodyGridParams, GridError, PatchReport, gerr};

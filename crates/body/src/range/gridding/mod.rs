@@ -8,13 +8,13 @@
 use std::collections::HashMap;
 use std::time::Instant;
 
-use crate::coons::arc_lengths;
-use crate::improve::ImproveParams;
+use atelier_grid::coons::arc_lengths;
+use atelier_grid::improve::ImproveParams;
 
 use super::body::RangeBody;
 use super::field::{DepthField, Layer};
-use super::part::Part;
 use super::side::View;
+use crate::part::Part;
 
 use builder::{Builder, Piece, cap, half_ring_nodes};
 
