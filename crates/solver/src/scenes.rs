@@ -292,6 +292,39 @@ impl RestCriterion {
     }
 }
 
+/// The rest test of a [`RestCriterion`] followed over a run: call [`RestWatch::at_rest`] after
+/// every step. ([`run_drape`] and the facade's drape scenario both stop by it.)
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RestWatch {
+    criterion: RestCriterion,
+    below_since: Option<f64>,
+    eps: f64,
+}
+
+impl RestWatch {
+    /// Watch for `criterion` in a run of step `dt` (times compare within 1e-9·dt).
+    pub fn new(criterion: RestCriterion, dt: f64) -> Self {
+        Self {
+            criterion,
+            below_since: None,
+            eps: 1e-9 * dt,
+        }
+    }
+
+    /// After a step ending at `time` with the free nodes' RMS speed `rms_speed` (m/s): whether
+    /// the cloth is at rest (below the rest speed for the hold time, and past the minimum time).
+    pub fn at_rest(&mut self, time: f64, rms_speed: f64) -> bool {
+        let c = &self.criterion;
+        if rms_speed < c.rest_speed {
+            let since = *self.below_since.get_or_insert(time);
+            time >= c.min_time - self.eps && time - since >= c.hold_time - self.eps
+        } else {
+            self.below_since = None;
+            false
+        }
+    }
+}
+
 /// One sample of a drape run's history.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DrapeSample {
@@ -380,7 +413,7 @@ pub fn run_drape(
 ) -> Result<DrapeRun, StepError> {
     let mut wall = Duration::ZERO;
     let mut steps = 0;
-    let mut below_since: Option<f64> = None;
+    let mut watch = RestWatch::new(*stop, params.dt);
     let mut settled = false;
     let mut max_strain_error: f64 = 0.0;
     let mut shape_iterations = 0usize;
@@ -413,15 +446,9 @@ pub fn run_drape(
             trace.push(sample(state));
             next_sample += stop.sample_interval;
         }
-        let v = rms_speed(cloth, state);
-        if v < stop.rest_speed {
-            let since = *below_since.get_or_insert(state.time);
-            if state.time >= stop.min_time - eps && state.time - since >= stop.hold_time - eps {
-                settled = true;
-                break;
-            }
-        } else {
-            below_since = None;
+        if watch.at_rest(state.time, rms_speed(cloth, state)) {
+            settled = true;
+            break;
         }
     }
     if trace.last().is_none_or(|s| s.time < state.time - eps) {
@@ -448,6 +475,32 @@ pub fn run_drape(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rest test by hand: below the rest speed from 0.3 s, at rest once both the minimum
+    /// time (0.5 s) and the hold (0.2 s) have passed; a step above the speed restarts the hold.
+    #[test]
+    fn the_rest_watch_waits_for_the_hold_and_the_minimum_time() {
+        let dt = 0.05;
+        let mut w = RestWatch::new(RestCriterion::default(), dt);
+        let at = |w: &mut RestWatch, k: usize, v: f64| w.at_rest(k as f64 * dt, v);
+        for k in 1..6 {
+            assert!(!at(&mut w, k, 1.0), "moving at step {k}");
+        }
+        // Below from 0.30 s: 0.45 s is within the hold and before the minimum time.
+        for k in 6..10 {
+            assert!(!at(&mut w, k, 1e-3), "held only since 0.30 s at step {k}");
+        }
+        assert!(at(&mut w, 10, 1e-3), "0.50 s: held 0.20 s, past 0.5 s");
+        let mut w = RestWatch::new(RestCriterion::default(), dt);
+        for k in 6..=9 {
+            assert!(!at(&mut w, k, 1e-3));
+        }
+        assert!(!at(&mut w, 10, 1.0), "a jump restarts the hold");
+        for k in 11..15 {
+            assert!(!at(&mut w, k, 1e-3), "held since 0.55 s at step {k}");
+        }
+        assert!(at(&mut w, 15, 1e-3), "0.75 s: held 0.20 s again");
+    }
 
     #[test]
     fn thesis_scene_is_the_60_by_5_grid() {

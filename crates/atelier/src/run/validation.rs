@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::scenes::{DrapeScene, rms_speed};
+use atelier_solver::scenes::{DrapeScene, RestCriterion, RestWatch, rms_speed};
 use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
 use nalgebra::Vector3;
 
@@ -170,27 +170,19 @@ pub(super) fn drape(
     };
     params.validate().map_err(RunError::setup("drape scene"))?;
     // The rest criterion of `run_drape` (RestCriterion::default()).
-    let stop = atelier_solver::scenes::RestCriterion::default();
+    let mut watch = RestWatch::new(RestCriterion::default(), params.dt);
     let eps = 1e-9 * params.dt;
     let mut stepper = Stepper::new(&state, spec.frame_interval);
     let mut solver = Solver::new();
-    let mut below_since: Option<f64> = None;
     let mut settled = false;
     while state.time < spec.max_time - eps {
         if !stepper.step(&mut solver, &cloth, &mut state, &params) {
             break;
         }
         progress(state.time / spec.max_time);
-        if spec.until_rest {
-            if rms_speed(&cloth, &state) < stop.rest_speed {
-                let since = *below_since.get_or_insert(state.time);
-                if state.time >= stop.min_time - eps && state.time - since >= stop.hold_time - eps {
-                    settled = true;
-                    break;
-                }
-            } else {
-                below_since = None;
-            }
+        if spec.until_rest && watch.at_rest(state.time, rms_speed(&cloth, &state)) {
+            settled = true;
+            break;
         }
     }
     stepper.finish(&state);
