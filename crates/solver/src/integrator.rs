@@ -13,6 +13,7 @@ use crate::cloth::Cloth;
 use crate::params::StepParams;
 use crate::state::ClothState;
 use crate::step::{CollisionHook, Solver, StepError, StepReport};
+use nalgebra::Vector3;
 
 /// What a step is given besides the cloth and its state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,6 +38,21 @@ pub trait Integrator: Send {
         input: StepInput,
         hook: &mut dyn CollisionHook,
     ) -> Result<StepReport, StepError>;
+
+    /// Whether its steps have a tolerance, so that a step's report says whether it met it (a
+    /// caller may then take a step that missed it again in shorter steps). Default: no (the
+    /// baselines).
+    fn has_tolerance(&self) -> bool {
+        false
+    }
+
+    /// Per-node external forces (N, one per node; empty: none) added to every step from now on.
+    /// Returns whether the integrator applies them; the default ignores them and returns false
+    /// (the baselines).
+    fn set_external_forces(&mut self, forces: Vec<Vector3<f64>>) -> bool {
+        let _ = forces;
+        false
+    }
 }
 
 /// The PARTY step with its parameters.
@@ -62,6 +78,15 @@ impl Integrator for Party {
         self.params.dt = input.dt;
         self.params.gravity = input.gravity;
         self.solver.step_with(cloth, state, &self.params, hook)
+    }
+
+    fn has_tolerance(&self) -> bool {
+        true
+    }
+
+    fn set_external_forces(&mut self, forces: Vec<Vector3<f64>>) -> bool {
+        self.solver.external_forces = forces;
+        true
     }
 }
 

@@ -24,7 +24,9 @@ use atelier_body::model::LabelledMesh;
 use atelier_collide::parts::Motion as PartMotion;
 use atelier_collide::{ContactError, ContactMaterial, ContactParams, RigidParts, V3};
 use atelier_solver::baselines::{MassSpring, Xpbd};
-use atelier_solver::integrator::{Integrator, MassSpringIntegrator, StepInput, XpbdIntegrator};
+use atelier_solver::integrator::{
+    Integrator, MassSpringIntegrator, Party, StepInput, XpbdIntegrator,
+};
 use atelier_solver::{
     BodyContact, ClothState, Solver, StageTimings, StepError, StepParams, StepReport,
 };
@@ -130,13 +132,12 @@ pub struct StepOutcome {
 pub struct Simulation {
     scene: Scene,
     state: ClothState,
-    solver: Solver,
-    /// A baseline integrator stepping the garment instead of PARTY (`settings.solver`), with its
-    /// parameters; `None`: PARTY, `solver` with `params`.
-    baseline: Option<Box<dyn Integrator>>,
+    /// The cloth integrator (`settings.solver`: PARTY or a baseline) with its parameters.
+    integrator: Box<dyn Integrator>,
+    /// Gravity given to the steps: none while sewing and pushing, the scene's from settling on.
+    gravity: [f64; 3],
     sewing: Sewing,
     contact: BodyContact,
-    params: StepParams,
     phase: Phase,
     phase_start: f64,
     rest: LabelledMesh,
@@ -256,24 +257,26 @@ impl Simulation {
             gravity: [0.0; 3],
             ..settings.step.clone()
         };
-        let baseline: Option<Box<dyn Integrator>> = match &settings.solver {
-            ClothSolver::Party => None,
-            ClothSolver::Xpbd(p) => Some(Box::new(XpbdIntegrator {
+        let integrator: Box<dyn Integrator> = match &settings.solver {
+            ClothSolver::Party => Box::new(Party {
+                solver: Solver::new(),
+                params,
+            }),
+            ClothSolver::Xpbd(p) => Box::new(XpbdIntegrator {
                 solver: Xpbd::new(),
                 params: p.clone(),
-            })),
-            ClothSolver::MassSpring(p) => Some(Box::new(MassSpringIntegrator {
+            }),
+            ClothSolver::MassSpring(p) => Box::new(MassSpringIntegrator {
                 solver: MassSpring::new(),
                 params: p.clone(),
-            })),
+            }),
         };
         Ok(Self {
             state,
-            solver: Solver::new(),
-            baseline,
+            integrator,
+            gravity: [0.0; 3],
             sewing,
             contact,
-            params,
             phase: Phase::Sewing,
             phase_start: 0.0,
             next_posed: posed.clone(),
@@ -370,10 +373,16 @@ impl Simulation {
                     Dressing::OneSided { push, .. } => {
                         self.phase = Phase::Pushing;
                         let masses = self.scene.garment.cloth.cloth.masses();
-                        self.solver.external_forces = masses
+                        let push = masses
                             .iter()
                             .map(|m| V3::new(0.0, 0.0, -push * m))
                             .collect();
+                        if !self.integrator.set_external_forces(push) {
+                            self.warnings.push(format!(
+                                "the {} integrator applies no external force: the garment is not pushed through the body",
+                                self.integrator.name()
+                            ));
+                        }
                     }
                 }
             }
@@ -401,7 +410,7 @@ impl Simulation {
                     unreachable!("pushing only in one-sided dressing")
                 };
                 if due(push_time) && self.last_inside == 0 {
-                    self.solver.external_forces.clear();
+                    self.integrator.set_external_forces(Vec::new());
                     self.contact.set_one_sided(false);
                     self.contact.set_friction(s.friction);
                     self.phase_start = t;
@@ -430,7 +439,7 @@ impl Simulation {
 
     fn start_settling(&mut self) {
         self.phase = Phase::Settling;
-        self.params.gravity = self.scene.settings.gravity;
+        self.gravity = self.scene.settings.gravity;
         if self.scene.settings.self_collision {
             self.contact.set_self_collision(true);
         }
@@ -454,7 +463,6 @@ impl Simulation {
                 time: t,
                 source,
             })?;
-        self.params.dt = dt;
         timings.solver = report.timings;
         // Diagnostics: every node against the body at the end of the step.
         let clock = Instant::now();
@@ -494,7 +502,7 @@ impl Simulation {
         depth: u32,
         timings: &mut Timings,
     ) -> Result<(StepReport, usize), Failure> {
-        let before = (depth > 0 && self.baseline.is_none())
+        let before = (depth > 0 && self.integrator.has_tolerance())
             .then(|| (self.state.clone(), self.posed.clone()));
         let whole = self.cloth_step(tm, h, moving, timings)?;
         let Some((state, posed)) = before.filter(|_| !whole.converged) else {
@@ -565,22 +573,20 @@ impl Simulation {
                 .map_err(Failure::Body)?;
             timings.body += clock.elapsed();
         }
-        self.params.dt = h;
         let mut hooks = Chain(vec![&mut self.sewing, &mut self.contact]);
-        let cloth = &self.scene.garment.cloth.cloth;
-        let report = match &mut self.baseline {
-            None => self
-                .solver
-                .step_with(cloth, &mut self.state, &self.params, &mut hooks),
-            Some(integrator) => {
-                let input = StepInput {
-                    dt: h,
-                    gravity: self.params.gravity,
-                };
-                integrator.advance(cloth, &mut self.state, input, &mut hooks)
-            }
-        }
-        .map_err(Failure::Step)?;
+        let input = StepInput {
+            dt: h,
+            gravity: self.gravity,
+        };
+        let report = self
+            .integrator
+            .advance(
+                &self.scene.garment.cloth.cloth,
+                &mut self.state,
+                input,
+                &mut hooks,
+            )
+            .map_err(Failure::Step)?;
         if moving {
             std::mem::swap(&mut self.posed, &mut self.next_posed);
         }
