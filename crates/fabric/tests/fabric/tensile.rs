@@ -280,45 +280,6 @@ proptest! {
         prop_assert!(w >= -1e-9 * l.summary().wt(), "work {} for {}–{}", w, lo, hi);
     }
 
-    /// Measured-like loops (8 points per concave branch, random shapes): the minor branches (40)
-    /// alone can leave the major loop here (by up to 10.1 % of EMT in 2000 random loops, see
-    /// docs/fabric.md); the model clamps them to it. The strain stays inside and continuous.
-    #[test]
-    fn measured_loops_keep_minor_branches_inside(
-        emt in 0.02f64..0.12,
-        residual in 0.2f64..0.7,
-        mut up_steps in prop::collection::vec(0.05f64..1.0, 8),
-        mut down_steps in prop::collection::vec(0.05f64..1.0, 8),
-        forces in prop::collection::vec(0.0f64..1.0, 1..40),
-    ) {
-        let fm = 490.0;
-        up_steps.sort_by(|a, b| b.total_cmp(a));
-        down_steps.sort_by(|a, b| b.total_cmp(a));
-        let (su, sd): (f64, f64) = (up_steps.iter().sum(), down_steps.iter().sum());
-        let res = residual * emt;
-        let (mut up, mut down) = (vec![(0.0, 0.0)], vec![(0.0, res)]);
-        let (mut eu, mut ed) = (0.0, res);
-        for i in 0..8 {
-            let f = fm * (i + 1) as f64 / 8.0;
-            eu += emt * up_steps[i] / su;
-            ed += (emt - res) * down_steps[i] / sd;
-            up.push((f, eu));
-            down.push((f, ed.max(eu)));
-        }
-        // Skip the rare draws whose interpolated branches cross.
-        let Ok(l) = TensileLoop::from_measured(&up, &down) else { return Ok(()) };
-        let tol = 1e-12 * emt;
-        let mut st = TensileState::VIRGIN;
-        for x in forces {
-            let f = x * fm;
-            let before = st;
-            let eps = st.update(&l, f);
-            let turn = before.force();
-            prop_assert!((st.branch_strain(&l, turn) - before.branch_strain(&l, turn)).abs() <= 1e3 * tol);
-            let (lo, hi) = l.strains(f);
-            prop_assert!(eps >= lo - tol && eps <= hi + tol);
-        }
-    }
 }
 
 /// The reversal dead band (`TensileLoop::with_deadband`): a rising force with backward jitter
@@ -410,6 +371,61 @@ proptest! {
                 let jump = (st.strain(&l, edge + d) - st.strain(&l, edge - d)).abs();
                 prop_assert!(jump <= 1e-6 * l.apex_strain(), "jump {} at the edge {}", jump, edge);
             }
+        }
+    }
+}
+
+// Its own block for its own reject limit: about 38 % of these draws are rejected, not passed
+// (measured: 1 024 rejects against 1 587 passes before the default limit stopped it). The
+// generator lets the unloading samples touch the loading ones (`ed.max(eu)`), and the PCHIP
+// interpolants of two branches that touch at a knot cross just above it; `from_measured`
+// refuses crossing branches, as it must. (Until issue 23 these draws returned Ok, i.e. passed.)
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 2000,
+        max_global_rejects: 2500,
+        ..ProptestConfig::default()
+    })]
+
+    /// Measured-like loops (8 points per concave branch, random shapes): the minor branches (40)
+    /// alone can leave the major loop here (by up to 10.1 % of EMT in 2000 random loops, see
+    /// docs/fabric.md); the model clamps them to it. The strain stays inside and continuous.
+    #[test]
+    fn measured_loops_keep_minor_branches_inside(
+        emt in 0.02f64..0.12,
+        residual in 0.2f64..0.7,
+        mut up_steps in prop::collection::vec(0.05f64..1.0, 8),
+        mut down_steps in prop::collection::vec(0.05f64..1.0, 8),
+        forces in prop::collection::vec(0.0f64..1.0, 1..40),
+    ) {
+        let fm = 490.0;
+        up_steps.sort_by(|a, b| b.total_cmp(a));
+        down_steps.sort_by(|a, b| b.total_cmp(a));
+        let (su, sd): (f64, f64) = (up_steps.iter().sum(), down_steps.iter().sum());
+        let res = residual * emt;
+        let (mut up, mut down) = (vec![(0.0, 0.0)], vec![(0.0, res)]);
+        let (mut eu, mut ed) = (0.0, res);
+        for i in 0..8 {
+            let f = fm * (i + 1) as f64 / 8.0;
+            eu += emt * up_steps[i] / su;
+            ed += (emt - res) * down_steps[i] / sd;
+            up.push((f, eu));
+            down.push((f, ed.max(eu)));
+        }
+        // Reject (not pass) the rare draws whose interpolated branches cross.
+        let l = TensileLoop::from_measured(&up, &down);
+        prop_assume!(l.is_ok());
+        let l = l.expect("assumed");
+        let tol = 1e-12 * emt;
+        let mut st = TensileState::VIRGIN;
+        for x in forces {
+            let f = x * fm;
+            let before = st;
+            let eps = st.update(&l, f);
+            let turn = before.force();
+            prop_assert!((st.branch_strain(&l, turn) - before.branch_strain(&l, turn)).abs() <= 1e3 * tol);
+            let (lo, hi) = l.strains(f);
+            prop_assert!(eps >= lo - tol && eps <= hi + tol);
         }
     }
 }
