@@ -4,7 +4,8 @@
 //! The defaults come from `atelier_solver::StepParams::default()`, serialized field by field
 //! (serde_json, rendered in Rust/RON notation: `Direct { refactor_after: 4 }`). The words come
 //! from the source: `crates/solver/src/params.rs` is read for the `pub field: Type,` lines of
-//! `StepParams` and their `///` doc comments, and for the enums a field's type names (also in a
+//! `StepParams` and their `///` doc comments (a field whose type is another struct there, a
+//! stage's group, expands to its fields as `group.field`), and for the enums a field's type names (also in a
 //! module that params.rs `use`s from the crate, e.g. `shear_angle::ShearMeasure`): their variants,
 //! the variants' fields and their doc comments. The unit is what a doc comment's first clause
 //! names after its last comma (`Time step Δt, s.`), or a doc comment that is only a unit
@@ -386,11 +387,34 @@ pub fn generate(root: &Path) -> Result<String> {
     writeln!(out)?;
     writeln!(out, "| knob | default | unit | range | what |")?;
     writeln!(out, "|---|---|---|---|---|")?;
-    let mut enums = Vec::new();
+    // A field whose type is a struct of params.rs (a stage's group: `ShapeParams`, …) stands
+    // for its fields, named `group.field` as in a scenario file's `step: (shape: (…))`.
+    let mut knobs: Vec<(Field, Value)> = Vec::new();
     for field in fields {
         let value = defaults
             .get(&field.name)
             .with_context(|| format!("`{}` is not a serialized field of StepParams", field.name))?;
+        match params.item(&field.ty) {
+            Some(Item::Struct(inner)) => {
+                for f in inner {
+                    let v = value.get(&f.name).with_context(|| {
+                        format!("`{}.{}` is not a serialized field", field.name, f.name)
+                    })?;
+                    knobs.push((
+                        Field {
+                            name: format!("{}.{}", field.name, f.name),
+                            ty: f.ty.clone(),
+                            doc: f.doc.clone(),
+                        },
+                        v.clone(),
+                    ));
+                }
+            }
+            _ => knobs.push((field.clone(), value.clone())),
+        }
+    }
+    let mut enums = Vec::new();
+    for (field, value) in &knobs {
         check_stated_default(&field.name, &field.doc, value)?;
         let mut range = doc_range(&field.doc);
         if range.is_empty() {

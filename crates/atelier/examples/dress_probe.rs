@@ -18,7 +18,7 @@ fn main() {
     };
     let mut scene = Scene::load(spec, file.parent().unwrap()).expect("scene");
     if let Ok(t) = std::env::var("PROBE_TOL") {
-        scene.settings.step.shape_tolerance = t.parse().expect("PROBE_TOL: a number");
+        scene.settings.step.shape.tolerance = t.parse().expect("PROBE_TOL: a number");
     }
     let mut sim = Simulation::new(scene).expect("sim");
     let (mut steps, mut bad, mut worst) = (0, 0, 0.0f64);
@@ -35,7 +35,7 @@ fn main() {
                 iterations += o.report.shape_iterations;
                 halved += usize::from(o.substeps > 1);
                 extra += usize::from(
-                    o.report.collision_passes > sim.scene().settings.step.collision_passes,
+                    o.report.collision_passes > sim.scene().settings.step.shape.collision_passes,
                 );
                 if !o.report.converged {
                     bad += 1;

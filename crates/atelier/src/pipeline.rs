@@ -131,7 +131,7 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
         ClothSolver::Xpbd(_) => Some(solvers::XPBD),
         ClothSolver::MassSpring(_) => Some(solvers::MASS_SPRING),
     };
-    let tolerance = scene.settings.step.shape_tolerance;
+    let tolerance = scene.settings.step.shape.tolerance;
     let mut tally = Tally::default();
     let mut sim = Simulation::new(scene)?;
     let to3 = |v: &[atelier_collide::V3]| -> Vec<[f64; 3]> {

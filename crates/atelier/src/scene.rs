@@ -509,13 +509,16 @@ mod tests {
         assert_eq!(e.field, "settings.friction");
         let bad = Settings {
             step: StepParams {
-                shape_max_iterations: 0,
+                shape: atelier_solver::ShapeParams {
+                    max_iterations: 0,
+                    ..Settings::default().step.shape
+                },
                 ..Settings::default().step
             },
             ..Settings::default()
         };
         let e = bad.check().expect_err("no iterations");
-        assert_eq!(e.field, "settings.step.shape_max_iterations");
+        assert_eq!(e.field, "settings.step.shape.max_iterations");
         let bad = Settings {
             dressing: Dressing::OneSided {
                 push: 5.0,

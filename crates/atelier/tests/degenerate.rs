@@ -323,3 +323,40 @@ fn a_scene_setting_out_of_range_names_the_scene_and_the_field() {
     };
     assert_eq!(v.field, "observed", "{e}");
 }
+
+/// The step parameters in a scenario file are grouped by stage (issue 22): the nested form
+/// parses to the values given, every other field at its default, and the flat names of before
+/// are refused as unknown fields naming the place (not silently ignored).
+#[test]
+fn step_parameters_are_grouped_by_stage_and_flat_names_are_refused() {
+    use atelier::scenario::{Scenario, ScenarioKind};
+    let drape = |step: &str| {
+        format!(
+            r#"(name: "d", reproduces: "step-parameter test", kind: Drape(fabric: "../fabrics/silk.ron", tester: Jis, step: ({step})))"#
+        )
+    };
+    let s = Scenario::parse(
+        &drape("damping: 0.5, shape: (tolerance: 1e-6, max_iterations: 7), bending: (off: true)"),
+        Path::new("s.ron"),
+    )
+    .expect("nested step parameters parse");
+    let ScenarioKind::Drape(d) = s.kind else {
+        panic!("a drape")
+    };
+    let defaults = atelier_solver::StepParams::default();
+    assert_eq!(d.step.damping, 0.5);
+    assert_eq!(d.step.shape.tolerance, 1e-6);
+    assert_eq!(d.step.shape.max_iterations, 7);
+    assert!(d.step.bending.off);
+    assert_eq!(
+        d.step.shape.collision_passes,
+        defaults.shape.collision_passes
+    );
+    assert_eq!(d.step.internal, defaults.internal);
+    assert_eq!(d.step.shear, defaults.shear);
+    let e = Scenario::parse(&drape("shape_tolerance: 1e-6"), Path::new("s.ron"))
+        .expect_err("a flat name is refused");
+    assert_eq!(e.kind, ErrorKind::UnknownField, "{e}");
+    assert!(e.to_string().contains("shape_tolerance"), "{e}");
+    assert!(e.field.contains("step"), "{e}");
+}

@@ -439,7 +439,7 @@ fn small_drape_expecting(step: &str, extra: &str) -> String {
 fn a_run_that_cannot_converge_reports_its_unconverged_steps_and_warns() {
     let out = temp_dir("unconverged");
     let report = run_text(
-        &small_drape("shape_max_iterations: 1, shape_tolerance: 1e-9"),
+        &small_drape("shape: (max_iterations: 1, tolerance: 1e-9)"),
         &out,
     );
     assert!(report.failure.is_none(), "{:?}", report.failure);
@@ -505,7 +505,7 @@ fn a_run_that_cannot_converge_reports_its_unconverged_steps_and_warns() {
 /// passes (the warning stays), beyond it the expectation is not met.
 #[test]
 fn a_scenario_bounding_unconverged_fraction_decides_whether_the_run_passes() {
-    let step = "shape_max_iterations: 1, shape_tolerance: 1e-9";
+    let step = "shape: (max_iterations: 1, tolerance: 1e-9)";
     let out = temp_dir("unconverged-accepted");
     let accepted = run_text(
         &small_drape_expecting(step, r#"(metric: "unconverged_fraction", max: 1.0)"#),

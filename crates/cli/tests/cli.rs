@@ -211,7 +211,7 @@ fn unconverged_drape_scenario(extra: &str) -> String {
     name: "cli_unconverged",
     reproduces: "a drape whose steps cannot converge (CLI test)",
     kind: Drape(fabric: "{}", tester: Jis, n_around: 24, n_rings: 4, dt: 0.002, max_time: 0.1,
-        until_rest: false, step: (shape_max_iterations: 1, shape_tolerance: 1e-9)),
+        until_rest: false, step: (shape: (max_iterations: 1, tolerance: 1e-9))),
     expectations: [{extra}],
 )"#,
         fabric_path()

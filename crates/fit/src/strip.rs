@@ -106,7 +106,7 @@ impl Default for TurnedRun {
 /// The strip of `fabric` cut along `direction`, overhanging by `overhang` (m), observed at
 /// each of `angles` (degrees, non-decreasing, in [0, 180]). Step parameters: Δt = 0.25·h,
 /// shape tolerance 1e-8 m (the default 1e-6 m over this Δt leaves the nodes jittering at cm/s),
-/// `implicit_stick_slope` on (without it a hysteretic strip chatters and never rests).
+/// `bending.implicit_stick_slope` on (without it a hysteretic strip chatters and never rests).
 pub fn turned_strip(
     fabric: &Fabric,
     direction: StripDirection,
@@ -167,8 +167,14 @@ pub fn turned_strip(
     let mut params = StepParams {
         dt: 0.25 * h,
         damping: run.damping,
-        shape_tolerance: 1e-8,
-        implicit_stick_slope: true,
+        shape: atelier_solver::ShapeParams {
+            tolerance: 1e-8,
+            ..atelier_solver::ShapeParams::default()
+        },
+        bending: atelier_solver::BendingParams {
+            implicit_stick_slope: true,
+            ..atelier_solver::BendingParams::default()
+        },
         ..StepParams::default()
     };
     params.validate()?;

@@ -755,8 +755,11 @@ fn peer_scene(
     };
     let mut state = ClothState::flat(&cloth, 0.0);
     let params = StepParams {
-        shape_max_iterations: shape_cap,
-        long_range_attachments: long_range,
+        shape: atelier_solver::ShapeParams {
+            max_iterations: shape_cap,
+            long_range_attachments: long_range,
+            ..atelier_solver::ShapeParams::default()
+        },
         ..StepParams::default()
     };
     let mut solver = Solver::new();
@@ -810,7 +813,7 @@ fn peers(_c: &mut Criterion) {
     for &(side, cap, long_range) in cases {
         let setting = if long_range {
             format!("shape_max_iterations={cap}, long_range_attachments")
-        } else if cap == StepParams::default().shape_max_iterations {
+        } else if cap == StepParams::default().shape.max_iterations {
             "defaults".to_string()
         } else {
             format!("shape_max_iterations={cap}")

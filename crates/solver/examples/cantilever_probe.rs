@@ -53,11 +53,17 @@ fn main() {
             dt: get("dt", 0.005),
             damping: get("damping", 1.0),
             hysteresis: get("hysteresis", 0.0) != 0.0,
-            shape_tolerance: get("tol", 1e-4),
-            bending_model: if get("thesis", 0.0) != 0.0 {
-                BendingModel::Thesis
-            } else {
-                BendingModel::Implicit
+            shape: atelier_solver::ShapeParams {
+                tolerance: get("tol", 1e-4),
+                ..atelier_solver::ShapeParams::default()
+            },
+            bending: atelier_solver::BendingParams {
+                model: if get("thesis", 0.0) != 0.0 {
+                    BendingModel::Thesis
+                } else {
+                    BendingModel::Implicit
+                },
+                ..atelier_solver::BendingParams::default()
             },
             ..StepParams::default()
         };

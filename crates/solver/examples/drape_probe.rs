@@ -60,21 +60,30 @@ fn main() {
     };
     let params = StepParams {
         dt: get("dt", 0.01),
-        shape_tolerance: get("tol", 1e-4),
-        shape_max_iterations: get("cap", 100.0) as usize,
-        shear_scale: get("shear", 1.0),
-        shear_measure: if word("measure", "midpoint") == "corners" {
-            ShearMeasure::Corners
-        } else {
-            ShearMeasure::Midpoint
-        },
         hysteresis: get("hysteresis", 1.0) != 0.0,
-        shape_method: method,
-        bending_off: get("bending_off", 0.0) != 0.0,
-        implicit_stick_slope: get("stick", 0.0) != 0.0,
         damping: get("damping", 0.2),
-        collision_passes: get("passes", 2.0) as usize,
         divergence_strain: get("divergence", 1.0),
+        shape: atelier_solver::ShapeParams {
+            tolerance: get("tol", 1e-4),
+            max_iterations: get("cap", 100.0) as usize,
+            method,
+            collision_passes: get("passes", 2.0) as usize,
+            ..atelier_solver::ShapeParams::default()
+        },
+        shear: atelier_solver::ShearParams {
+            scale: get("shear", 1.0),
+            measure: if word("measure", "midpoint") == "corners" {
+                ShearMeasure::Corners
+            } else {
+                ShearMeasure::Midpoint
+            },
+            ..atelier_solver::ShearParams::default()
+        },
+        bending: atelier_solver::BendingParams {
+            off: get("bending_off", 0.0) != 0.0,
+            implicit_stick_slope: get("stick", 0.0) != 0.0,
+            ..atelier_solver::BendingParams::default()
+        },
         ..StepParams::default()
     };
     let (cloth, mut state) = scene.build(&fabric).expect("scene");

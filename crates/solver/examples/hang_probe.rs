@@ -28,24 +28,33 @@ fn main() {
     let mut state = ClothState::placed(&cloth, place);
     let params = StepParams {
         damping: 1.0,
-        tension: if balance {
-            Tension::Balance
-        } else {
-            Tension::Constraint
-        },
-        shear_scale: if args.iter().any(|a| a == "noshear") {
-            0.0
-        } else {
-            std::env::var("SHEAR").map_or(1.0, |v| v.parse().expect("scale"))
-        },
-        shear_measure: if args.iter().any(|a| a == "corners") {
-            atelier_solver::ShearMeasure::Corners
-        } else {
-            atelier_solver::ShearMeasure::Midpoint
-        },
         dt: std::env::var("DT").map_or(0.01, |v| v.parse().expect("dt")),
-        bending_off: args.iter().any(|a| a == "nobend"),
         hysteresis: !args.iter().any(|a| a == "nohyst"),
+        internal: atelier_solver::InternalParams {
+            tension: if balance {
+                Tension::Balance
+            } else {
+                Tension::Constraint
+            },
+            ..atelier_solver::InternalParams::default()
+        },
+        shear: atelier_solver::ShearParams {
+            scale: if args.iter().any(|a| a == "noshear") {
+                0.0
+            } else {
+                std::env::var("SHEAR").map_or(1.0, |v| v.parse().expect("scale"))
+            },
+            measure: if args.iter().any(|a| a == "corners") {
+                atelier_solver::ShearMeasure::Corners
+            } else {
+                atelier_solver::ShearMeasure::Midpoint
+            },
+            ..atelier_solver::ShearParams::default()
+        },
+        bending: atelier_solver::BendingParams {
+            off: args.iter().any(|a| a == "nobend"),
+            ..atelier_solver::BendingParams::default()
+        },
         ..StepParams::default()
     };
     let mut solver = Solver::new();

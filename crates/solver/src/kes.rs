@@ -27,7 +27,7 @@ use atelier_grid::{ClothTopology, StructuredGrid, TopologyError};
 use nalgebra::Vector3;
 
 use crate::cloth::{Cloth, ClothError, PinMotion};
-use crate::params::StepParams;
+use crate::params::{ShapeParams, StepParams};
 use crate::state::ClothState;
 use crate::step::{Solver, StepError};
 
@@ -185,9 +185,12 @@ fn instrument_params(dt: f64, tolerance: f64) -> StepParams {
     StepParams {
         dt,
         gravity: [0.0; 3],
-        collision_passes: 1,
-        shape_tolerance: tolerance,
-        shape_max_iterations: 100,
+        shape: ShapeParams {
+            collision_passes: 1,
+            tolerance,
+            max_iterations: 100,
+            ..ShapeParams::default()
+        },
         ..StepParams::default()
     }
 }

@@ -32,8 +32,8 @@ pub mod wet;
 pub use cloth::{Cloth, ClothError, ClothOptions, Incidence, Pin, PinMotion};
 pub use contact::BodyContact;
 pub use params::{
-    BendingModel, ConstraintKind, InternalMethod, ParamError, ShapeMethod, StepParams, Tension,
-    TolerancePolicy,
+    BendingModel, BendingParams, ConstraintKind, InternalMethod, InternalParams, ParamError,
+    ShapeMethod, ShapeParams, ShearParams, StepParams, Tension, TolerancePolicy,
 };
 pub use shear_angle::ShearMeasure;
 pub use state::ClothState;

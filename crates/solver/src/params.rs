@@ -36,7 +36,7 @@ pub enum ShapeMethod {
         cg_iterations: usize,
     },
     /// The thesis: local corrections, each row by its own diagonal, scaled by the largest
-    /// constraint count of its nodes (`shape_step` the γ of (51)).
+    /// constraint count of its nodes (`shape.step` the γ of (51)).
     Jacobi,
     /// Jacobi with Chebyshev semi-iterative acceleration (Wang 2015); `rho` estimates the
     /// spectral radius of the plain iteration, in (0, 1).
@@ -85,7 +85,7 @@ pub enum Tension {
     #[default]
     Constraint,
     /// The thesis (43)–(47): forces p ≥ 0 that balance the external and bending forces at the
-    /// start of the step as far as the edges can, by projected descent to `internal_tolerance`
+    /// start of the step as far as the edges can, by projected descent to `internal.tolerance`
     /// (it cannot balance a load across the cloth, and on long chains it needs many
     /// iterations: `docs/solver.md`).
     Balance,
@@ -102,7 +102,7 @@ pub enum BendingModel {
     #[default]
     Implicit,
     /// The thesis (28)–(32): an explicit force along the node normals from the slots' circle
-    /// curvatures, with the linearised implicit term of `implicit_bending` (stable only up to
+    /// curvatures, with the linearised implicit term of `bending.implicit` (stable only up to
     /// Δt ≈ 0.4·h s/m; `docs/solver.md`).
     Thesis,
 }
@@ -125,8 +125,11 @@ pub enum TolerancePolicy {
     },
 }
 
-/// Parameters of one step. The table in `docs/solver.md` is generated from
+/// Parameters of one step, grouped by stage ([`InternalParams`], [`ShapeParams`],
+/// [`ShearParams`], [`BendingParams`]). The table in `docs/solver.md` is generated from
 /// `StepParams::default()` (`cargo xtask knob-table`), so the docs cannot disagree with it.
+/// In a scenario file: `step: (damping: 0.5, shape: (tolerance: 1e-6), bending: (off: true))`;
+/// every field may be left out (its default).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct StepParams {
@@ -138,81 +141,16 @@ pub struct StepParams {
     /// default 0.2 (a light fabric's terminal speed of a few m/s; a physical value, not a
     /// convergence aid — see `docs/solver.md`).
     pub damping: f64,
-    /// Where the edges' axial forces come from. Default `Constraint`.
-    pub tension: Tension,
-    /// Internal-force method ([`Tension::Balance`]). Default `Accelerated`.
-    pub internal_method: InternalMethod,
-    /// Internal-force step γ as a fraction of the largest stable step 1/λ_max(AᵀA). Range (0, 2);
-    /// default 1.
-    pub internal_step: f64,
-    /// ε^c: the internal-force iterations stop when the projected gradient of E falls below
-    /// ε^c times its value with all forces zero (a relative residual). Range (0, 1); default
-    /// 1e-4.
-    pub internal_tolerance: f64,
-    /// Iteration cap of the internal forces (a step whose forces stop at the cap says so in its
-    /// report). Range ≥ 1; default 200 (warm-started, they usually need far fewer).
-    pub internal_max_iterations: usize,
-    /// Shape-constraint method. Default `Newton`.
-    pub shape_method: ShapeMethod,
-    /// Shape step γ of the Jacobi and Chebyshev methods: a row's correction times γ over the
-    /// largest constraint count of its nodes. Range (0, 1]; default 1.
-    pub shape_step: f64,
-    /// ε^e: the shape stage stops when the largest relative violation — |l − l̄|/l⁰ over the
-    /// edges, the compliant residual |C + α̃λ| (rad) over the cells, the excess of ties and the
-    /// depth behind contact planes over the node spacing — is at most this. Range (0, 0.1];
-    /// default 1e-4. A step that ends above it is reported as not converged.
-    pub shape_tolerance: f64,
-    /// Iteration cap of the shape stage per collision pass. Range ≥ 1; default 100 (the
-    /// global methods need 2–10 where the cloth is not flat; a flat sheet starting to sag is
-    /// a singular start and needs more).
-    pub shape_max_iterations: usize,
-    /// Collision passes per step; the shape stage runs before each (the thesis: two passes).
-    /// Range ≥ 1; default 2. Up to 4 more are made while the last pass's solve converged and
-    /// its collision pass left the shape above the tolerance.
-    pub collision_passes: usize,
-    /// Axial edges: equality or stretch-only. Default `Equality` (see `docs/solver.md`).
-    pub axial_constraint: ConstraintKind,
-    /// How a cell's shear angle is measured (`shear_angle`). Default `Midpoint` (the angle
-    /// between the cell's midpoint vectors, in the plane of its diagonals).
-    pub shear_measure: ShearMeasure,
-    /// Factor on the fabric's shear stiffness (the loop's stresses and slopes): 1 the fabric,
-    /// 0 no shear resistance at all (the lower bound of the drape studies). Range [0, 1e3];
-    /// default 1.
-    pub shear_scale: f64,
-    /// Reversal dead band of the shear loop, rad: an angle change back smaller than this does
-    /// not start a minor loop. Range [0, 0.1); default 1e-4 rad (0.006°).
-    pub shear_deadband: f64,
+    /// The internal-force stage.
+    pub internal: InternalParams,
+    /// The shape stage and the collision passes.
+    pub shape: ShapeParams,
+    /// The shear of the cells.
+    pub shear: ShearParams,
+    /// The bending stage.
+    pub bending: BendingParams,
     /// Tolerance policy. Default `Fixed`.
     pub tolerance_policy: TolerancePolicy,
-    /// How bending enters the step. Default `Implicit`.
-    pub bending_model: BendingModel,
-    /// [`BendingModel::Thesis`] only: treat the bending stiffness of each node implicitly along
-    /// its normal (a linearised implicit term solved by BiCGSTAB). Lifts the explicit limit Δt < 2√(μ/k) on fine grids and
-    /// stiff fabrics; changes no equilibrium. Default true.
-    pub implicit_bending: bool,
-    /// Relative residual at which the implicit bending solve stops. Range (0, 1); default 1e-6.
-    pub bending_tolerance: f64,
-    /// Iteration cap of the implicit bending solve (a step that stops at it says so). Range ≥ 1;
-    /// default 200.
-    pub bending_max_iterations: usize,
-    /// Linearise the implicit bending term with the regularised spindle's steepest slope,
-    /// `bending_stick_slope`·B, where the fabric has bending hysteresis (instead of B). Default
-    /// false (`docs/solver.md`).
-    pub implicit_stick_slope: bool,
-    /// Regularisation of the bending hysteresis: the tangent of the spindle's square-root curves
-    /// is capped at this multiple of B over a tiny band (`Spindle::with_stick_slope`). Range > 1
-    /// (∞ = exact); default 4.
-    pub bending_stick_slope: f64,
-    /// Reversal dead band of the bending hysteresis, as a fraction of each characteristic's
-    /// M₀/B (`Spindle::with_deadband`). Range [0, 1); default 0.05.
-    pub bending_deadband: f64,
-    /// Skip bending entirely (an inextensible chain or membrane). Default false.
-    pub bending_off: bool,
-    /// Long-range attachments ([`crate::long_range`]) for the local shape methods: every free
-    /// node held within its rest distance from the pins times (1 + the step's largest target
-    /// strain). Nothing runs for a cloth without pins, nor with the global methods. Default
-    /// false.
-    pub long_range_attachments: bool,
     /// Divergence guard: a step whose result stretches or shrinks any edge by more than this
     /// strain (|l/l⁰ − 1|; a diagonal's change over its cell's size, the longest of the
     /// diagonal and the cell's sides) fails with `StepError::Diverged` and keeps the state.
@@ -230,32 +168,161 @@ impl Default for StepParams {
             dt: 0.01,
             gravity: [0.0, 0.0, -atelier_fabric::STANDARD_GRAVITY],
             damping: 0.2,
-            tension: Tension::Constraint,
-            internal_method: InternalMethod::Accelerated,
-            internal_step: 1.0,
-            internal_tolerance: 1e-4,
-            internal_max_iterations: 200,
-            shape_method: ShapeMethod::DEFAULT,
-            shape_step: 1.0,
-            shape_tolerance: 1e-4,
-            shape_max_iterations: 100,
-            collision_passes: 2,
-            axial_constraint: ConstraintKind::Equality,
-            shear_measure: ShearMeasure::Midpoint,
-            shear_scale: 1.0,
-            shear_deadband: 1e-4,
+            internal: InternalParams::default(),
+            shape: ShapeParams::default(),
+            shear: ShearParams::default(),
+            bending: BendingParams::default(),
             tolerance_policy: TolerancePolicy::Fixed,
-            bending_model: BendingModel::Implicit,
-            implicit_bending: true,
-            bending_tolerance: 1e-6,
-            bending_max_iterations: 200,
-            implicit_stick_slope: false,
-            bending_stick_slope: 4.0,
-            bending_deadband: 0.05,
-            bending_off: false,
-            long_range_attachments: false,
             divergence_strain: 1.0,
             hysteresis: true,
+        }
+    }
+}
+
+/// The internal-force stage (thesis (43)–(47)): where the axial forces come from and how they are solved.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InternalParams {
+    /// Where the edges' axial forces come from. Default `Constraint`.
+    pub tension: Tension,
+    /// Internal-force method ([`Tension::Balance`]). Default `Accelerated`.
+    pub method: InternalMethod,
+    /// Internal-force step γ as a fraction of the largest stable step 1/λ_max(AᵀA). Range (0, 2);
+    /// default 1.
+    pub step: f64,
+    /// ε^c: the internal-force iterations stop when the projected gradient of E falls below
+    /// ε^c times its value with all forces zero (a relative residual). Range (0, 1); default
+    /// 1e-4.
+    pub tolerance: f64,
+    /// Iteration cap of the internal forces (a step whose forces stop at the cap says so in its
+    /// report). Range ≥ 1; default 200 (warm-started, they usually need far fewer).
+    pub max_iterations: usize,
+}
+
+impl Default for InternalParams {
+    fn default() -> Self {
+        Self {
+            tension: Tension::Constraint,
+            method: InternalMethod::Accelerated,
+            step: 1.0,
+            tolerance: 1e-4,
+            max_iterations: 200,
+        }
+    }
+}
+
+/// The shape stage (thesis (49)–(51)) and the collision passes it runs with.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ShapeParams {
+    /// Shape-constraint method. Default `Newton`.
+    pub method: ShapeMethod,
+    /// Shape step γ of the Jacobi and Chebyshev methods: a row's correction times γ over the
+    /// largest constraint count of its nodes. Range (0, 1]; default 1.
+    pub step: f64,
+    /// ε^e: the shape stage stops when the largest relative violation — |l − l̄|/l⁰ over the
+    /// edges, the compliant residual |C + α̃λ| (rad) over the cells, the excess of ties and the
+    /// depth behind contact planes over the node spacing — is at most this. Range (0, 0.1];
+    /// default 1e-4. A step that ends above it is reported as not converged.
+    pub tolerance: f64,
+    /// Iteration cap of the shape stage per collision pass. Range ≥ 1; default 100 (the
+    /// global methods need 2–10 where the cloth is not flat; a flat sheet starting to sag is
+    /// a singular start and needs more).
+    pub max_iterations: usize,
+    /// Collision passes per step; the shape stage runs before each (the thesis: two passes).
+    /// Range ≥ 1; default 2. Up to 4 more are made while the last pass's solve converged and
+    /// its collision pass left the shape above the tolerance.
+    pub collision_passes: usize,
+    /// Axial edges: equality or stretch-only. Default `Equality` (see `docs/solver.md`).
+    pub axial_constraint: ConstraintKind,
+    /// Long-range attachments ([`crate::long_range`]) for the local shape methods: every free
+    /// node held within its rest distance from the pins times (1 + the step's largest target
+    /// strain). Nothing runs for a cloth without pins, nor with the global methods. Default
+    /// false.
+    pub long_range_attachments: bool,
+}
+
+impl Default for ShapeParams {
+    fn default() -> Self {
+        Self {
+            method: ShapeMethod::DEFAULT,
+            step: 1.0,
+            tolerance: 1e-4,
+            max_iterations: 100,
+            collision_passes: 2,
+            axial_constraint: ConstraintKind::Equality,
+            long_range_attachments: false,
+        }
+    }
+}
+
+/// The shear of the cells (method.md §2b): how the angle is measured, the fabric's stiffness scaled, the reversal band.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ShearParams {
+    /// How a cell's shear angle is measured (`shear_angle`). Default `Midpoint` (the angle
+    /// between the cell's midpoint vectors, in the plane of its diagonals).
+    pub measure: ShearMeasure,
+    /// Factor on the fabric's shear stiffness (the loop's stresses and slopes): 1 the fabric,
+    /// 0 no shear resistance at all (the lower bound of the drape studies). Range [0, 1e3];
+    /// default 1.
+    pub scale: f64,
+    /// Reversal dead band of the shear loop, rad: an angle change back smaller than this does
+    /// not start a minor loop. Range [0, 0.1); default 1e-4 rad (0.006°).
+    pub deadband: f64,
+}
+
+impl Default for ShearParams {
+    fn default() -> Self {
+        Self {
+            measure: ShearMeasure::Midpoint,
+            scale: 1.0,
+            deadband: 1e-4,
+        }
+    }
+}
+
+/// The bending stage (thesis (28)–(32)): its model, its implicit solve and its hysteresis.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BendingParams {
+    /// How bending enters the step. Default `Implicit`.
+    pub model: BendingModel,
+    /// [`BendingModel::Thesis`] only: treat the bending stiffness of each node implicitly along
+    /// its normal (a linearised implicit term solved by BiCGSTAB). Lifts the explicit limit Δt < 2√(μ/k) on fine grids and
+    /// stiff fabrics; changes no equilibrium. Default true.
+    pub implicit: bool,
+    /// Relative residual at which the implicit bending solve stops. Range (0, 1); default 1e-6.
+    pub tolerance: f64,
+    /// Iteration cap of the implicit bending solve (a step that stops at it says so). Range ≥ 1;
+    /// default 200.
+    pub max_iterations: usize,
+    /// Linearise the implicit bending term with the regularised spindle's steepest slope,
+    /// `bending.stick_slope`·B, where the fabric has bending hysteresis (instead of B). Default
+    /// false (`docs/solver.md`).
+    pub implicit_stick_slope: bool,
+    /// Regularisation of the bending hysteresis: the tangent of the spindle's square-root curves
+    /// is capped at this multiple of B over a tiny band (`Spindle::with_stick_slope`). Range > 1
+    /// (∞ = exact); default 4.
+    pub stick_slope: f64,
+    /// Reversal dead band of the bending hysteresis, as a fraction of each characteristic's
+    /// M₀/B (`Spindle::with_deadband`). Range [0, 1); default 0.05.
+    pub deadband: f64,
+    /// Skip bending entirely (an inextensible chain or membrane). Default false.
+    pub off: bool,
+}
+
+impl Default for BendingParams {
+    fn default() -> Self {
+        Self {
+            model: BendingModel::Implicit,
+            implicit: true,
+            tolerance: 1e-6,
+            max_iterations: 200,
+            implicit_stick_slope: false,
+            stick_slope: 4.0,
+            deadband: 0.05,
+            off: false,
         }
     }
 }
@@ -305,72 +372,72 @@ impl StepParams {
     pub fn validate(&self) -> Result<(), ParamError> {
         check_motion(self.dt, self.gravity, self.damping)?;
         check(
-            "internal_step",
-            self.internal_step,
-            self.internal_step > 0.0 && self.internal_step < 2.0,
+            "internal.step",
+            self.internal.step,
+            self.internal.step > 0.0 && self.internal.step < 2.0,
             "(0, 2)",
         )?;
         check(
-            "internal_tolerance",
-            self.internal_tolerance,
-            self.internal_tolerance > 0.0 && self.internal_tolerance < 1.0,
+            "internal.tolerance",
+            self.internal.tolerance,
+            self.internal.tolerance > 0.0 && self.internal.tolerance < 1.0,
             "(0, 1)",
         )?;
         check(
-            "internal_max_iterations",
-            self.internal_max_iterations as f64,
-            self.internal_max_iterations >= 1,
+            "internal.max_iterations",
+            self.internal.max_iterations as f64,
+            self.internal.max_iterations >= 1,
             "≥ 1",
         )?;
         check(
-            "shape_step",
-            self.shape_step,
-            self.shape_step > 0.0 && self.shape_step <= 1.0,
+            "shape.step",
+            self.shape.step,
+            self.shape.step > 0.0 && self.shape.step <= 1.0,
             "(0, 1]",
         )?;
         check(
-            "shape_tolerance",
-            self.shape_tolerance,
-            self.shape_tolerance > 0.0 && self.shape_tolerance <= 0.1,
+            "shape.tolerance",
+            self.shape.tolerance,
+            self.shape.tolerance > 0.0 && self.shape.tolerance <= 0.1,
             "(0, 0.1]",
         )?;
         for (name, value) in [
-            ("shape_max_iterations", self.shape_max_iterations),
-            ("collision_passes", self.collision_passes),
-            ("bending_max_iterations", self.bending_max_iterations),
+            ("shape.max_iterations", self.shape.max_iterations),
+            ("shape.collision_passes", self.shape.collision_passes),
+            ("bending.max_iterations", self.bending.max_iterations),
         ] {
             check(name, value as f64, value >= 1, "≥ 1")?;
         }
         check(
-            "bending_tolerance",
-            self.bending_tolerance,
-            self.bending_tolerance > 0.0 && self.bending_tolerance < 1.0,
+            "bending.tolerance",
+            self.bending.tolerance,
+            self.bending.tolerance > 0.0 && self.bending.tolerance < 1.0,
             "(0, 1)",
         )?;
         check(
-            "shear_scale",
-            self.shear_scale,
-            (0.0..=1e3).contains(&self.shear_scale),
+            "shear.scale",
+            self.shear.scale,
+            (0.0..=1e3).contains(&self.shear.scale),
             "[0, 1000]",
         )?;
         check(
-            "shear_deadband",
-            self.shear_deadband,
-            (0.0..0.1).contains(&self.shear_deadband),
+            "shear.deadband",
+            self.shear.deadband,
+            (0.0..0.1).contains(&self.shear.deadband),
             "[0, 0.1) rad",
         )?;
-        match self.shape_method {
+        match self.shape.method {
             ShapeMethod::Chebyshev { rho } => {
-                check("shape_method.rho", rho, rho > 0.0 && rho < 1.0, "(0, 1)")?
+                check("shape.method.rho", rho, rho > 0.0 && rho < 1.0, "(0, 1)")?
             }
             ShapeMethod::GaussSeidel { omega } => check(
-                "shape_method.omega",
+                "shape.method.omega",
                 omega,
                 omega > 0.0 && omega < 2.0,
                 "(0, 2)",
             )?,
             ShapeMethod::ConjugateGradient { cg_iterations } => check(
-                "shape_method.cg_iterations",
+                "shape.method.cg_iterations",
                 cg_iterations as f64,
                 cg_iterations >= 1,
                 "≥ 1",
@@ -439,10 +506,13 @@ mod tests {
         };
         assert_eq!(bad.validate().expect_err("dt").name, "dt");
         let bad = StepParams {
-            shape_method: ShapeMethod::Chebyshev { rho: 1.0 },
+            shape: ShapeParams {
+                method: ShapeMethod::Chebyshev { rho: 1.0 },
+                ..ShapeParams::default()
+            },
             ..StepParams::default()
         };
-        assert_eq!(bad.validate().expect_err("rho").name, "shape_method.rho");
+        assert_eq!(bad.validate().expect_err("rho").name, "shape.method.rho");
         let bad = StepParams {
             damping: f64::NAN,
             ..StepParams::default()

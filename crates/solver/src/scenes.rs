@@ -365,7 +365,7 @@ pub struct DrapeRun {
     pub mean_shape_iterations: f64,
     /// Steps that did not meet their tolerances (`StepReport::converged` false).
     pub unconverged_steps: usize,
-    /// Steps whose shape constraints ended above `shape_tolerance` (after the last collision
+    /// Steps whose shape constraints ended above `shape.tolerance` (after the last collision
     /// pass).
     pub shape_unconverged_steps: usize,
     /// Largest violation any step ended with.

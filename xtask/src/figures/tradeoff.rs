@@ -89,10 +89,16 @@ fn reference(dt: f64, cap: usize) -> Config {
         format!("reference Δt {dt}, caps {cap}/{}", cap / 2),
         dt,
         StepParams {
-            shape_tolerance: 1e-9,
-            internal_tolerance: 1e-9,
-            shape_max_iterations: cap,
-            internal_max_iterations: cap / 2,
+            shape: atelier_solver::ShapeParams {
+                tolerance: 1e-9,
+                max_iterations: cap,
+                ..atelier_solver::ShapeParams::default()
+            },
+            internal: atelier_solver::InternalParams {
+                tolerance: 1e-9,
+                max_iterations: cap / 2,
+                ..atelier_solver::InternalParams::default()
+            },
             ..StepParams::default()
         },
         false,
@@ -124,7 +130,10 @@ fn configs(quick: bool) -> Vec<Config> {
             format!("shape cap {cap}"),
             0.01,
             StepParams {
-                shape_max_iterations: cap,
+                shape: atelier_solver::ShapeParams {
+                    max_iterations: cap,
+                    ..d().shape
+                },
                 ..d()
             },
             false,
@@ -136,7 +145,10 @@ fn configs(quick: bool) -> Vec<Config> {
             format!("internal cap {cap}"),
             0.01,
             StepParams {
-                internal_max_iterations: cap,
+                internal: atelier_solver::InternalParams {
+                    max_iterations: cap,
+                    ..d().internal
+                },
                 ..d()
             },
             false,
@@ -148,9 +160,15 @@ fn configs(quick: bool) -> Vec<Config> {
             format!("shape tol. {tol:e} m, internal {:e}", tol * 100.0),
             0.01,
             StepParams {
-                shape_tolerance: tol,
-                internal_tolerance: (tol * 100.0).min(0.5),
-                shape_max_iterations: if tol < 1e-6 { 100 } else { 30 },
+                shape: atelier_solver::ShapeParams {
+                    tolerance: tol,
+                    max_iterations: if tol < 1e-6 { 100 } else { 30 },
+                    ..d().shape
+                },
+                internal: atelier_solver::InternalParams {
+                    tolerance: (tol * 100.0).min(0.5),
+                    ..d().internal
+                },
                 ..d()
             },
             false,

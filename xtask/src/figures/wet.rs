@@ -226,8 +226,14 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     for (dt, cap) in [(0.005, 10), (0.005, 5), (0.01, 5)] {
         let cheap = WetSolver::Party(StepParams {
             dt,
-            shape_max_iterations: cap,
-            internal_max_iterations: cap,
+            shape: atelier_solver::ShapeParams {
+                max_iterations: cap,
+                ..atelier_solver::ShapeParams::default()
+            },
+            internal: atelier_solver::InternalParams {
+                max_iterations: cap,
+                ..atelier_solver::InternalParams::default()
+            },
             ..StepParams::default()
         });
         let name = format!("PARTY step, 2 threads, ≤ {cap} shape and {cap} internal iterations");

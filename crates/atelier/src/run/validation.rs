@@ -53,7 +53,7 @@ impl Stepper {
             failure: None,
             last_good: state.positions.clone(),
             tally: Tally::default(),
-            tolerance: StepParams::default().shape_tolerance,
+            tolerance: StepParams::default().shape.tolerance,
         }
     }
 
@@ -74,7 +74,7 @@ impl Stepper {
             Ok(r) => {
                 self.steps += 1;
                 self.tally.add(&r, t, None);
-                self.tolerance = params.shape_tolerance;
+                self.tolerance = params.shape.tolerance;
                 self.timings.add(&Timings {
                     solver: r.timings,
                     ..Timings::default()
@@ -432,7 +432,10 @@ pub(super) fn catenary(
     let params = StepParams {
         dt: spec.dt,
         damping: spec.damping,
-        bending_off: true,
+        bending: atelier_solver::BendingParams {
+            off: true,
+            ..atelier_solver::BendingParams::default()
+        },
         ..StepParams::default()
     };
     params.validate().map_err(RunError::setup(SCENE))?;

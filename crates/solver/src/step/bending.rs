@@ -25,10 +25,10 @@ impl Solver {
     /// from the spindle (peeked through the hysteresis state), node moment
     /// M = Σ_dir ½ Σ W_a m_a over directions with both neighbours (a free edge carries no moment),
     /// force F = n Σ (M_a − M)/l_a. Also the diagonal bending stiffness for the implicit term.
-    /// With `bending_off`, or the implicit bending model (bending is then a constraint of the
+    /// With `bending.off`, or the implicit bending model (bending is then a constraint of the
     /// shape stage, `targets.rs`): no force and no stiffness.
     pub(super) fn bending(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
-        if params.bending_off || params.bending_model == BendingModel::Implicit {
+        if params.bending.off || params.bending.model == BendingModel::Implicit {
             self.s.f_sum.iter_mut().for_each(|f| *f = V3::zeros());
             self.s.slot_coef.iter_mut().for_each(|k| *k = [0.0; SLOTS]);
             return;
@@ -42,7 +42,7 @@ impl Solver {
         );
         let pos = &state.positions;
         let hysteresis = params.hysteresis && cloth.bending_hysteretic();
-        let (stick, band) = (params.bending_stick_slope, params.bending_deadband);
+        let (stick, band) = (params.bending.stick_slope, params.bending.deadband);
         let s = &mut self.s;
         let normal = &s.normal;
         fill(&mut s.eta, |i| {
@@ -91,9 +91,12 @@ impl Solver {
         // neighbours (the node moment counts only those), and the slot length.
         // With hysteresis the curve after a turning point is steeper than B (up to the stick
         // slope): linearising with B alone leaves (stick − 1)·B explicit, which alternates
-        // step by step on fine grids (`implicit_stick_slope`).
+        // step by step on fine grids (`bending.implicit_stick_slope`).
         let steepest = |sp: &atelier_fabric::Spindle| {
-            if params.implicit_stick_slope && hysteresis && sp.is_hysteretic() && stick.is_finite()
+            if params.bending.implicit_stick_slope
+                && hysteresis
+                && sp.is_hysteretic()
+                && stick.is_finite()
             {
                 stick
             } else {

@@ -29,7 +29,7 @@ fn free_energy(chunk: &mut Vec<f64>, f: &[V3], inv: &[f64]) -> f64 {
 impl Solver {
     /// The internal-force stage: λ_max estimated when there is none, p warm-started from the
     /// state's forces (the diagonals' at zero), the axial phase to `internal_tolerance ×
-    /// factor` of its projected gradient at p = 0 or `internal_max_iterations`, and F^m gathered
+    /// factor` of its projected gradient at p = 0 or `internal.max_iterations`, and F^m gathered
     /// (less the surface's reaction when a pressure stage is on). Returns the iterations, the
     /// final E over its value at p = 0, and whether the tolerance was met.
     pub(super) fn internal_forces(
@@ -39,7 +39,7 @@ impl Solver {
         params: &StepParams,
         factor: f64,
     ) -> (usize, f64, bool) {
-        if params.tension == Tension::Constraint {
+        if params.internal.tension == Tension::Constraint {
             // The forces are the last step's constraint forces; nothing to balance.
             self.s.p.copy_from_slice(&state.axial_force);
             self.s.f_m.copy_from_slice(&self.s.f_sum);
@@ -180,7 +180,7 @@ impl Solver {
     ) -> (usize, bool) {
         let edges = cloth.topology().edges();
         let lambda = self.lambda.map_or(1.0, |l| l[usize::from(diagonals)]);
-        let mut gamma = params.internal_step / lambda;
+        let mut gamma = params.internal.step / lambda;
         let in_phase = |e: usize| edges[e].kind.is_axial() != diagonals;
         // Scale of the optimality test: the gradient with all forces zero (the load itself).
         for e in 0..self.s.p_y.len() {
@@ -206,13 +206,13 @@ impl Solver {
                 return (0, true);
             }
         }
-        let tol = params.internal_tolerance * factor * g_ref;
+        let tol = params.internal.tolerance * factor * g_ref;
         self.s.p_prev.copy_from_slice(&self.s.p);
         self.s.p_warm.copy_from_slice(&self.s.p);
         let mut e_old = e_start;
         let mut iterations = 0;
         let mut converged = false;
-        match params.internal_method {
+        match params.internal.method {
             InternalMethod::SteepestDescent => {
                 loop {
                     self.gradient(cloth, diagonals);
@@ -220,7 +220,7 @@ impl Solver {
                         converged = true;
                         break;
                     }
-                    if iterations >= params.internal_max_iterations {
+                    if iterations >= params.internal.max_iterations {
                         break;
                     }
                     iterations += 1;
@@ -294,7 +294,7 @@ impl Solver {
         let mut t: f64 = 1.0;
         let mut iterations = 0;
         let mut converged = false;
-        while iterations < params.internal_max_iterations {
+        while iterations < params.internal.max_iterations {
             // F^m at y: the phase's forces from y, the other phase's from p (fixed).
             {
                 let (y, p, dir, f_sum) = (&s.ph_y, &s.p, &s.dir, &s.f_sum);

@@ -222,7 +222,7 @@ impl Solver {
             t0.elapsed() - report.timings.collision - (report.timings.pressure - pressure_before);
         report.converged = report.shape_converged
             && report.internal_converged
-            && report.bending_residual <= params.bending_tolerance;
+            && report.bending_residual <= params.bending.tolerance;
 
         // 5. Update and commit.
         let t0 = Instant::now();

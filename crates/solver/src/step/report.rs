@@ -140,7 +140,7 @@ pub struct StepReport {
     /// internal forces (`internal_converged`) and the implicit bending solve.
     pub converged: bool,
     /// Whether the largest relative violation the step ends with (after the last collision
-    /// pass), `violation`, is at most `shape_tolerance` (× the tolerance policy's factor).
+    /// pass), `violation`, is at most `shape.tolerance` (× the tolerance policy's factor).
     pub shape_converged: bool,
     /// The largest relative violation of the shape constraints the step ends with: |l − l̄|/l⁰
     /// of the axial edges, the cells' compliant residual (rad), ties' excess and depth behind
@@ -164,7 +164,7 @@ pub struct StepReport {
     pub internal_iterations: usize,
     /// Final E over its value at p = 0 (1 = nothing balanced, 0 = all external load carried).
     pub internal_residual: f64,
-    /// Whether the internal forces' projected gradient met `internal_tolerance`.
+    /// Whether the internal forces' projected gradient met `internal.tolerance`.
     pub internal_converged: bool,
     /// Iterations of the implicit bending solve.
     pub bending_iterations: usize,
@@ -216,7 +216,7 @@ impl SolveStats {
         self.steps += 1;
         self.unconverged += usize::from(!report.converged);
         self.shape_unconverged += usize::from(!report.shape_converged);
-        self.tolerance = params.shape_tolerance;
+        self.tolerance = params.shape.tolerance;
         // A NaN violation becomes the worst (and stays: nothing compares above it).
         if report.violation.is_nan() || report.violation > self.worst_violation {
             self.worst_violation = report.violation;
@@ -314,7 +314,10 @@ mod tests {
     #[test]
     fn solve_stats_count_unconverged_steps_and_keep_the_worst() {
         let params = StepParams {
-            shape_tolerance: 1e-6,
+            shape: crate::params::ShapeParams {
+                tolerance: 1e-6,
+                ..crate::params::ShapeParams::default()
+            },
             ..StepParams::default()
         };
         let report = |converged, shape_converged, violation, worst| StepReport {

@@ -17,7 +17,7 @@ pub const EXTRA_PASSES: usize = 4;
 
 impl Solver {
     /// The shape stage of one step: for each collision pass, the constraints solved to
-    /// `shape_tolerance × factor` (or `shape_max_iterations`), then the hook's pass; afterwards
+    /// `shape_tolerance × factor` (or `shape.max_iterations`), then the hook's pass; afterwards
     /// the violation the step ends with. Fills the shape fields of `report` and the collision
     /// and pressure timings.
     pub(super) fn shape_stage(
@@ -30,13 +30,13 @@ impl Solver {
         report: &mut StepReport,
     ) -> Result<(), StepError> {
         let (dt, time) = (params.dt, state.time);
-        let tol = params.shape_tolerance * factor;
-        let local = !params.shape_method.is_global();
+        let tol = params.shape.tolerance * factor;
+        let local = !params.shape.method.is_global();
         self.prepare_long_range(cloth, params, local);
         let mut collision = Duration::ZERO;
         let mut pressure = Duration::ZERO;
         let mut last: ShapeReport;
-        let tension = (params.tension == Tension::Constraint).then(|| EdgeTension {
+        let tension = (params.internal.tension == Tension::Constraint).then(|| EdgeTension {
             table: cloth.yarn_materials(),
             materials: cloth.edge_materials(),
             widths: cloth.edge_widths(),
@@ -59,8 +59,8 @@ impl Solver {
                     damping: params.damping,
                     targets: &$s.target,
                     tension,
-                    axial: params.axial_constraint,
-                    measure: params.shear_measure,
+                    axial: params.shape.axial_constraint,
+                    measure: params.shear.measure,
                     shear: &$s.cell_shear,
                     bends: &$s.node_bend,
                     ties: &$s.ties,
@@ -89,10 +89,10 @@ impl Solver {
                 .solve(
                     &problem,
                     &mut s.vel,
-                    params.shape_method,
-                    params.shape_step,
+                    params.shape.method,
+                    params.shape.step,
                     tol,
-                    params.shape_max_iterations,
+                    params.shape.max_iterations,
                     pass == 0,
                     &mut after,
                 )
@@ -109,14 +109,16 @@ impl Solver {
             collision += tc.elapsed();
             guard_nodes(Stage::Collision, "velocity", &self.s.vel, time)?;
             pass += 1;
-            if pass < params.collision_passes {
+            if pass < params.shape.collision_passes {
                 continue;
             }
             // What the step ends with, after the last collision pass.
             let s = &mut self.s;
             let problem = problem!(s);
             let (violation, worst) = self.projection.measure(&problem, &s.vel);
-            if violation <= tol || !last.converged || pass >= params.collision_passes + EXTRA_PASSES
+            if violation <= tol
+                || !last.converged
+                || pass >= params.shape.collision_passes + EXTRA_PASSES
             {
                 break (violation, worst);
             }
@@ -136,7 +138,7 @@ impl Solver {
     /// target strain as slack.
     fn prepare_long_range(&mut self, cloth: &Cloth, params: &StepParams, local: bool) {
         let s = &mut self.s;
-        s.long_range_on = params.long_range_attachments && local && !cloth.pins().is_empty();
+        s.long_range_on = params.shape.long_range_attachments && local && !cloth.pins().is_empty();
         if !s.long_range_on {
             return;
         }

@@ -58,26 +58,26 @@ impl Solver {
     }
 
     /// Each cell's shear constraint for this step: the shear angle γ₀ at the start of the step
-    /// (by `params.shear_measure`), the loop's stress τ₀ and tangent k there (through the
+    /// (by `params.shear.measure`), the loop's stress τ₀ and tangent k there (through the
     /// cell's hysteresis state; the loop's centre line Gγ without hysteresis), times
-    /// `shear_scale`; the constraint γ − (γ₀ − τ₀/k) = 0 with compliance 1/(k·S). Nothing when
-    /// `shear_scale` is 0 (no shear rows at all).
+    /// `shear.scale`; the constraint γ − (γ₀ − τ₀/k) = 0 with compliance 1/(k·S). Nothing when
+    /// `shear.scale` is 0 (no shear rows at all).
     pub(super) fn cell_shear(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
         let cells = cloth.topology().cells();
-        if params.shear_scale == 0.0 {
+        if params.shear.scale == 0.0 {
             self.s.cell_shear.clear();
             return;
         }
         self.s.cell_shear.resize(cells.len(), CellShear::default());
-        let rest = cloth.cell_rest_angles(params.shear_measure);
+        let rest = cloth.cell_rest_angles(params.shear.measure);
         let (l, lock, scale) = (
             cloth.shear_loop(),
             cloth.locking_angle(),
-            params.shear_scale,
+            params.shear.scale,
         );
         let hysteresis = params.hysteresis && l.is_hysteretic();
-        let l = l.clone().with_deadband(params.shear_deadband);
-        let (pos, states, measure) = (&state.positions, &state.shear, params.shear_measure);
+        let l = l.clone().with_deadband(params.shear.deadband);
+        let (pos, states, measure) = (&state.positions, &state.shear, params.shear.measure);
         fill(&mut self.s.cell_shear, |c| {
             let cell = &cells[c];
             let q = cell.nodes.map(|k| pos[k as usize]);
@@ -105,9 +105,9 @@ impl Solver {
     /// η₀ = C₀/l̄, the spindle's moment per width m₀ and
     /// local slope k there (through the hysteresis state of the direction's `+` slot; Bη and B
     /// without hysteresis); the constraint C − (C₀ − m₀ l̄/k) = 0 with compliance l̄²/(k·S).
-    /// Nothing with the thesis's bending model or `bending_off`.
+    /// Nothing with the thesis's bending model or `bending.off`.
     pub(super) fn node_bend(&mut self, cloth: &Cloth, state: &ClothState, params: &StepParams) {
-        if params.bending_model != BendingModel::Implicit || params.bending_off {
+        if params.bending.model != BendingModel::Implicit || params.bending.off {
             self.s.node_bend.clear();
             return;
         }
@@ -123,7 +123,7 @@ impl Solver {
             topo.edges(),
         );
         let hysteresis = params.hysteresis && cloth.bending_hysteretic();
-        let (stick, band) = (params.bending_stick_slope, params.bending_deadband);
+        let (stick, band) = (params.bending.stick_slope, params.bending.deadband);
         let (pos, states, normal) = (&state.positions, &state.bending, &self.s.normal);
         fill(&mut self.s.node_bend, |k| {
             let (i, dir) = (k / 2, k % 2);

@@ -78,7 +78,7 @@ impl Solver {
         {
             *v = w + e;
         }
-        if params.tension == Tension::Constraint {
+        if params.internal.tension == Tension::Constraint {
             // This step's constraint forces: what the next step's targets read, and the force
             // at which the tensile hysteresis is committed.
             self.projection.edge_forces(params.dt, &mut self.s.p);
@@ -97,12 +97,12 @@ impl Solver {
         // The cells' shear angles at the end of the step, by the step's measure.
         let (cells, rest, pos) = (
             cloth.topology().cells(),
-            cloth.cell_rest_angles(params.shear_measure),
+            cloth.cell_rest_angles(params.shear.measure),
             &state.positions,
         );
         fill(&mut self.s.shear, |c| {
             let q = cells[c].nodes.map(|k| pos[k as usize]);
-            rest[c] - cell_angle(params.shear_measure, &q)
+            rest[c] - cell_angle(params.shear.measure, &q)
         });
         state.shear_angle.copy_from_slice(&self.s.shear);
         self.commit_hysteresis(cloth, state, params);
@@ -125,8 +125,8 @@ impl Solver {
             }
         }
         let shear = cloth.shear_loop();
-        if shear.is_hysteretic() && params.shear_scale > 0.0 {
-            let l = shear.clone().with_deadband(params.shear_deadband);
+        if shear.is_hysteretic() && params.shear.scale > 0.0 {
+            let l = shear.clone().with_deadband(params.shear.deadband);
             for (st, &gamma) in state.shear.iter_mut().zip(&self.s.shear) {
                 st.update(&l, gamma);
             }
@@ -160,15 +160,15 @@ impl Solver {
                     .0 / l;
                     let spindle = regularised(
                         table.bending(smats[i][2 * dir]),
-                        params.bending_stick_slope,
-                        params.bending_deadband,
+                        params.bending.stick_slope,
+                        params.bending.deadband,
                     );
                     slots[2 * dir].update(&spindle, eta);
                 }
             }
         } else if cloth.bending_hysteretic()
-            && !params.bending_off
-            && params.bending_model == BendingModel::Thesis
+            && !params.bending.off
+            && params.bending.model == BendingModel::Thesis
         {
             let (axial, smats, eta) = (
                 cloth.bending_neighbours(),
@@ -180,8 +180,8 @@ impl Solver {
                     if axial[i][k] != NO_NODE {
                         let spindle = regularised(
                             table.bending(smats[i][k]),
-                            params.bending_stick_slope,
-                            params.bending_deadband,
+                            params.bending.stick_slope,
+                            params.bending.deadband,
                         );
                         st.update(&spindle, eta[i][k]);
                     }
@@ -207,7 +207,7 @@ impl Solver {
                 let edge = &edges[e as usize];
                 let l = (pos[edge.b as usize] - pos[edge.a as usize]).norm();
                 let err = (l - self.s.target[e as usize]) / edge.rest_length;
-                match params.axial_constraint {
+                match params.shape.axial_constraint {
                     ConstraintKind::Equality => err.abs(),
                     ConstraintKind::StretchOnly => err.max(0.0),
                 }

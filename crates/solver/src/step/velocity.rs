@@ -23,9 +23,9 @@ impl Solver {
         let dt = params.dt;
         let (mass, areas) = (cloth.masses(), cloth.topology().node_areas());
         let axial = cloth.bending_neighbours();
-        let implicit = params.implicit_bending
-            && !params.bending_off
-            && params.bending_model == BendingModel::Thesis;
+        let implicit = params.bending.implicit
+            && !params.bending.off
+            && params.bending.model == BendingModel::Thesis;
         let s = &mut self.s;
         let (f_m, normal) = (&s.f_m, &s.normal);
         let (vel0, pos) = (&state.velocities, &state.positions);
@@ -49,7 +49,7 @@ impl Solver {
         // to ~2√(μ/k), k ≈ 16WB/h³, which scales with h²). Unknowns: the normal speeds w of the
         // free nodes; (μ + cΔt) w − Δt² K w = (μ + cΔt) n·ṙ_explicit, K the bending stiffness
         // for normal displacements (the same stencil as the force, with B), solved by
-        // Jacobi-preconditioned BiCGSTAB to `bending_tolerance`. Statics are unchanged; rigid motions have K w = 0.
+        // Jacobi-preconditioned BiCGSTAB to `bending.tolerance`. Statics are unchanged; rigid motions have K w = 0.
         let k_apply = |w: &[f64],
                        dm: &mut [f64],
                        out: &mut [f64],
@@ -106,7 +106,7 @@ impl Solver {
         // not the gradient of an energy), so the solve is Jacobi-preconditioned BiCGSTAB.
         let n = s.w.len();
         let r0: f64 = s.w_r.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let (tol, cap) = (params.bending_tolerance * r0, params.bending_max_iterations);
+        let (tol, cap) = (params.bending.tolerance * r0, params.bending.max_iterations);
         let (mut iterations, mut residual) = (0, 0.0);
         if r0 > 0.0 {
             let apply_a = |x: &[f64],

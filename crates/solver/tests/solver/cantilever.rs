@@ -145,7 +145,10 @@ fn simulate(f: &Fabric, along: Along, length: f64, segments: usize, tolerance: f
     let params = StepParams {
         damping: 1.0,
         hysteresis: false,
-        shape_tolerance: tolerance,
+        shape: atelier_solver::ShapeParams {
+            tolerance,
+            ..atelier_solver::ShapeParams::default()
+        },
         ..StepParams::default()
     };
     let mut solver = Solver::new();

@@ -317,8 +317,8 @@ fn nudged_step(nudge: fn(usize) -> bool) -> atelier_solver::StepReport {
 /// push, the thesis's two passes.
 #[test]
 fn a_push_in_the_last_collision_pass_gets_another_pass() {
-    let tol = atelier_solver::StepParams::default().shape_tolerance;
-    let passes = atelier_solver::StepParams::default().collision_passes;
+    let tol = atelier_solver::StepParams::default().shape.tolerance;
+    let passes = atelier_solver::StepParams::default().shape.collision_passes;
     let quiet = nudged_step(|_| false);
     assert_eq!(quiet.collision_passes, passes, "{quiet:?}");
     assert!(quiet.shape_converged, "{quiet:?}");

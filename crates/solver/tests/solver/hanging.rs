@@ -38,11 +38,17 @@ fn hang_with(
     }
     let mut state = ClothState::placed(&cloth, place);
     let params = StepParams {
-        internal_method: method,
-        internal_max_iterations: cap,
         damping: 1.0,
-        long_range_attachments: long_range,
-        tension,
+        internal: atelier_solver::InternalParams {
+            method,
+            max_iterations: cap,
+            tension,
+            ..atelier_solver::InternalParams::default()
+        },
+        shape: atelier_solver::ShapeParams {
+            long_range_attachments: long_range,
+            ..atelier_solver::ShapeParams::default()
+        },
         ..StepParams::default()
     };
     let mut solver = Solver::new();
@@ -146,7 +152,10 @@ fn corner_pinned(side: usize, seconds: f64, long_range: bool) -> (f64, f64) {
     }
     let mut state = ClothState::flat(&cloth, 0.0);
     let params = StepParams {
-        long_range_attachments: long_range,
+        shape: atelier_solver::ShapeParams {
+            long_range_attachments: long_range,
+            ..atelier_solver::ShapeParams::default()
+        },
         ..StepParams::default()
     };
     let mut solver = Solver::new();
@@ -239,8 +248,11 @@ fn long_range_attachments_without_pins_change_nothing() {
     let run = |long_range| {
         let mut state = ClothState::flat(&cloth, 0.0);
         let params = StepParams {
-            long_range_attachments: long_range,
             gravity: [1.0, 0.0, -9.8],
+            shape: atelier_solver::ShapeParams {
+                long_range_attachments: long_range,
+                ..atelier_solver::ShapeParams::default()
+            },
             ..StepParams::default()
         };
         let mut solver = Solver::new();
@@ -295,15 +307,21 @@ fn stress_never_produces_non_finite_state() {
             let (cloth, mut state, _) = stress_scene(name);
             let params = StepParams {
                 dt,
-                internal_tolerance: 0.5,
-                internal_max_iterations: 5,
-                shape_tolerance: 1e-3,
-                shape_max_iterations: 5,
-                collision_passes: 1,
                 tolerance_policy: TolerancePolicy::Adaptive {
                     loose_factor: 1.5,
                     fast_speed: 1.0,
                     slow_speed: 0.1,
+                },
+                internal: atelier_solver::InternalParams {
+                    tolerance: 0.5,
+                    max_iterations: 5,
+                    ..atelier_solver::InternalParams::default()
+                },
+                shape: atelier_solver::ShapeParams {
+                    tolerance: 1e-3,
+                    max_iterations: 5,
+                    collision_passes: 1,
+                    ..atelier_solver::ShapeParams::default()
                 },
                 ..StepParams::default()
             };

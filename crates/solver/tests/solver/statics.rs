@@ -121,7 +121,10 @@ fn hanging_strip_matches_the_catenary() {
     let params = StepParams {
         dt: 0.005,
         damping: 2.0,
-        bending_off: true,
+        bending: atelier_solver::BendingParams {
+            off: true,
+            ..atelier_solver::BendingParams::default()
+        },
         ..StepParams::default()
     };
     let mut solver = Solver::new();

@@ -14,8 +14,8 @@
 //!    the reference's own uncertainty (their distance, a conservative bound on the reference's
 //!    error). Chebyshev or Jacobi iterations do not converge on this scene even with thousands
 //!    of iterations per step, so they cannot serve as the reference.
-//! 2. Sweeps, one knob at a time from the defaults: for PARTY Δt, ε^e (`shape_tolerance`), the
-//!    shape iteration cap, ε^c (`internal_tolerance`), the internal iteration cap and the shape
+//! 2. Sweeps, one knob at a time from the defaults: for PARTY Δt, ε^e (`shape.tolerance`), the
+//!    shape iteration cap, ε^c (`internal.tolerance`), the internal iteration cap and the shape
 //!    method; for the mass-spring baseline Δt (around its stability limit); for XPBD the
 //!    sweeps per substep and the substeps per step. The baselines run with their bending hinges
 //!    on (PARTY computes bending) and the same damping.
@@ -283,9 +283,12 @@ fn rms_distance(cloth: &Cloth, a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
 fn reference_params(dt: f64) -> StepParams {
     StepParams {
         dt,
-        shape_method: ShapeMethod::Direct { refactor_after: 0 },
-        shape_tolerance: 1e-8,
-        shape_max_iterations: 100,
+        shape: atelier_solver::ShapeParams {
+            method: ShapeMethod::Direct { refactor_after: 0 },
+            tolerance: 1e-8,
+            max_iterations: 100,
+            ..atelier_solver::ShapeParams::default()
+        },
         ..StepParams::default()
     }
 }
@@ -308,28 +311,40 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
     }
     for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
         let p = StepParams {
-            shape_tolerance: tol,
+            shape: atelier_solver::ShapeParams {
+                tolerance: tol,
+                ..d().shape
+            },
             ..d()
         };
         c.push(party("shape tolerance", format!("{tol:.0e} m"), p));
     }
     for cap in [10, 20, 30, 60, 120, 250, 500] {
         let p = StepParams {
-            shape_max_iterations: cap,
+            shape: atelier_solver::ShapeParams {
+                max_iterations: cap,
+                ..d().shape
+            },
             ..d()
         };
         c.push(party("shape cap", format!("{cap} per pass"), p));
     }
     for tol in [1e-2, 1e-4, 1e-6, 1e-8] {
         let p = StepParams {
-            internal_tolerance: tol,
+            internal: atelier_solver::InternalParams {
+                tolerance: tol,
+                ..d().internal
+            },
             ..d()
         };
         c.push(party("internal tolerance", format!("{tol:.0e}"), p));
     }
     for cap in [5, 10, 30, 50, 100, 200, 400] {
         let p = StepParams {
-            internal_max_iterations: cap,
+            internal: atelier_solver::InternalParams {
+                max_iterations: cap,
+                ..d().internal
+            },
             ..d()
         };
         c.push(party("internal cap", cap.to_string(), p));
@@ -348,8 +363,11 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
         ),
     ] {
         let p = StepParams {
-            shape_method: method,
-            shape_max_iterations: cap,
+            shape: atelier_solver::ShapeParams {
+                method,
+                max_iterations: cap,
+                ..d().shape
+            },
             ..d()
         };
         c.push(party("shape method", name.to_owned(), p));
@@ -373,8 +391,11 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
     // so their rest distances are the shortest paths along the edges).
     for cap in [10, 30, 60] {
         let p = StepParams {
-            long_range_attachments: true,
-            shape_max_iterations: cap,
+            shape: atelier_solver::ShapeParams {
+                long_range_attachments: true,
+                max_iterations: cap,
+                ..d().shape
+            },
             ..d()
         };
         c.push(party(
@@ -395,8 +416,11 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
     ] {
         let p = StepParams {
             dt,
-            shape_method: newton,
-            shape_max_iterations: cap,
+            shape: atelier_solver::ShapeParams {
+                method: newton,
+                max_iterations: cap,
+                ..d().shape
+            },
             ..d()
         };
         c.push(party(

@@ -179,7 +179,7 @@ pub struct ShapeProblem<'a> {
     /// fraction cΔt/(μ + cΔt) of the static load: a cantilever at rest drooped as under 4 %
     /// less gravity at Δt 5 ms).
     pub damping: f64,
-    /// Target length of every edge (axial ones used), m; with `tension` set, only for
+    /// Target length of every edge (axial ones used), m; with `internal.tension` set, only for
     /// reports (the targets then follow the solve's forces).
     pub targets: &'a [f64],
     /// With [`Tension::Constraint`]: the tensile characteristics the edge targets are read from

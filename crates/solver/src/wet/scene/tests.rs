@@ -35,7 +35,7 @@ fn party_runs_count_their_steps_reports() {
     assert_eq!((stats.steps, party.steps), (10, 10));
     assert!(stats.unconverged <= stats.steps && stats.shape_unconverged <= stats.unconverged);
     assert!(stats.worst_violation.is_finite());
-    assert_eq!(stats.tolerance.to_bits(), params.shape_tolerance.to_bits());
+    assert_eq!(stats.tolerance.to_bits(), params.shape.tolerance.to_bits());
     let yamada = WetSolver::Yamada(YamadaParams::default());
     let short = WetScene {
         duration: 0.001,
