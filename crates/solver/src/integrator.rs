@@ -90,61 +90,54 @@ impl Integrator for Party {
     }
 }
 
-/// The XPBD baseline with its parameters.
-pub struct XpbdIntegrator {
-    /// The integrator.
-    pub solver: Xpbd,
-    /// Its parameters (their `dt` and `gravity` are set from each step's input).
-    pub params: XpbdParams,
+/// A baseline integrator with its parameters behind [`Integrator`]: its Δt and gravity set
+/// from each step's input, its report converted (both baselines step alike).
+macro_rules! baseline_integrator {
+    ($(#[$doc:meta])* $name:ident, $solver:ty, $params:ty, $label:literal) => {
+        $(#[$doc])*
+        pub struct $name {
+            /// The integrator.
+            pub solver: $solver,
+            /// Its parameters (their `dt` and `gravity` are set from each step's input).
+            pub params: $params,
+        }
+
+        impl Integrator for $name {
+            fn name(&self) -> &'static str {
+                $label
+            }
+
+            fn advance(
+                &mut self,
+                cloth: &Cloth,
+                state: &mut ClothState,
+                input: StepInput,
+                hook: &mut dyn CollisionHook,
+            ) -> Result<StepReport, StepError> {
+                self.params.dt = input.dt;
+                self.params.gravity = input.gravity;
+                self.solver
+                    .step_with(cloth, state, &self.params, hook)
+                    .map(StepReport::from)
+            }
+        }
+    };
 }
 
-impl Integrator for XpbdIntegrator {
-    fn name(&self) -> &'static str {
-        "xpbd"
-    }
-
-    fn advance(
-        &mut self,
-        cloth: &Cloth,
-        state: &mut ClothState,
-        input: StepInput,
-        hook: &mut dyn CollisionHook,
-    ) -> Result<StepReport, StepError> {
-        self.params.dt = input.dt;
-        self.params.gravity = input.gravity;
-        self.solver
-            .step_with(cloth, state, &self.params, hook)
-            .map(StepReport::from)
-    }
-}
-
-/// The mass-spring baseline with its parameters.
-pub struct MassSpringIntegrator {
-    /// The integrator.
-    pub solver: MassSpring,
-    /// Its parameters (their `dt` and `gravity` are set from each step's input).
-    pub params: MassSpringParams,
-}
-
-impl Integrator for MassSpringIntegrator {
-    fn name(&self) -> &'static str {
-        "mass_spring"
-    }
-
-    fn advance(
-        &mut self,
-        cloth: &Cloth,
-        state: &mut ClothState,
-        input: StepInput,
-        hook: &mut dyn CollisionHook,
-    ) -> Result<StepReport, StepError> {
-        self.params.dt = input.dt;
-        self.params.gravity = input.gravity;
-        self.solver
-            .step_with(cloth, state, &self.params, hook)
-            .map(StepReport::from)
-    }
-}
+baseline_integrator!(
+    /// The XPBD baseline with its parameters.
+    XpbdIntegrator,
+    Xpbd,
+    XpbdParams,
+    "xpbd"
+);
+baseline_integrator!(
+    /// The mass-spring baseline with its parameters.
+    MassSpringIntegrator,
+    MassSpring,
+    MassSpringParams,
+    "mass_spring"
+);
 
 impl From<BaselineReport> for StepReport {
     /// A baseline's diagnostics in the PARTY step's report: its sweeps as shape iterations, its
