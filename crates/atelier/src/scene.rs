@@ -75,9 +75,9 @@ pub enum Dressing {
 /// same collision hook (`atelier_solver::baselines`, "Collisions and seams").
 ///
 /// In a scenario file: `solver: Party` (the default), `solver: Xpbd((substeps: 10, iterations:
-/// 4))`, `solver: MassSpring((substeps: 100))`. A baseline's `dt` and `gravity` are the scene's
-/// (`settings.dt`; gravity off while sewing): the baseline's `dt` field is ignored, its substeps
-/// divide the scene's Δt. The mass-spring model is explicit: its substep Δt/substeps must lie
+/// 4))`, `solver: MassSpring((substeps: 100))`. Every solver takes Δt and gravity from the scene
+/// with each step (`settings.dt`; gravity off while sewing); a baseline's substeps divide the
+/// scene's Δt. The mass-spring model is explicit: its substep Δt/substeps must lie
 /// below its stability limit (about 1.2·10⁻⁴ s for cotton on the dress's 2 cm grid).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -139,7 +139,7 @@ pub struct Settings {
     /// Interval between recorded frames, s. Default 0.04 (25 frames per second).
     pub frame_interval: f64,
     /// Overrides of the solver's step parameters: damping (air drag), tolerances and iteration
-    /// caps, tolerance policy, methods (Δt and gravity are set by the scene). Default: the
+    /// caps, tolerance policy, methods (Δt and gravity are the scene's, given with every step). Default: the
     /// solver's defaults (diagonals held at the targets of the fabric's shear characteristic,
     /// as in the thesis).
     pub step: StepParams,
@@ -311,12 +311,7 @@ impl Settings {
                 ));
             }
         }
-        let step = StepParams {
-            dt: self.dt,
-            gravity: self.gravity,
-            ..self.step.clone()
-        };
-        step.validate().map_err(|e| {
+        self.step.validate().map_err(|e| {
             InvalidValue::new(
                 ErrorKind::OutOfRange,
                 format!("settings.step.{}", e.name),
@@ -325,18 +320,8 @@ impl Settings {
         })?;
         let baseline = match &self.solver {
             ClothSolver::Party => Ok(()),
-            ClothSolver::Xpbd(p) => XpbdParams {
-                dt: self.dt,
-                gravity: self.gravity,
-                ..p.clone()
-            }
-            .validate(),
-            ClothSolver::MassSpring(p) => MassSpringParams {
-                dt: self.dt,
-                gravity: self.gravity,
-                ..p.clone()
-            }
-            .validate(),
+            ClothSolver::Xpbd(p) => p.validate(),
+            ClothSolver::MassSpring(p) => p.validate(),
         };
         baseline.map_err(|e| {
             InvalidValue::new(
@@ -562,16 +547,10 @@ mod tests {
             bad.check().expect_err("damping").field,
             "settings.solver.damping"
         );
-        // The baseline's own Δt is replaced by the scene's: a baseline dt out of range is not
-        // an error, the scene's is.
-        let ok = Settings {
-            solver: ClothSolver::Xpbd(XpbdParams {
-                dt: 5.0,
-                ..XpbdParams::default()
-            }),
-            ..Settings::default()
-        };
-        assert!(ok.check().is_ok());
+        // Δt is the scene's alone: a baseline has no Δt of its own to set.
+        let refused = ron::from_str::<Settings>("(solver: Xpbd((dt: 5.0)))")
+            .expect_err("a baseline's dt is not a field");
+        assert!(refused.to_string().contains("dt"), "{refused}");
         let bad = Settings {
             solver: ClothSolver::Xpbd(XpbdParams::default()),
             dressing: Dressing::OneSided {

@@ -8,7 +8,7 @@ use atelier::{GarmentCloth, Sewing, SewingParams};
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::ImproveParams;
 use atelier_grid::pattern::load_garment;
-use atelier_solver::{ClothState, Solver, StepParams};
+use atelier_solver::{ClothState, Solver, StepInput, StepParams};
 use nalgebra::Vector3;
 
 fn root() -> PathBuf {
@@ -38,20 +38,17 @@ fn the_flared_skirt_sews_itself_shut_and_stays_sewn() {
         };
     }
     let mut sewing = Sewing::new(g.pairs.clone(), SewingParams::default());
-    let mut params = StepParams {
-        dt: 0.01,
-        gravity: [0.0, 0.0, 0.0],
-        ..StepParams::default()
-    };
+    let params = StepParams::default();
+    let mut input = StepInput::weightless(0.01);
     let mut solver = Solver::new();
     let mut sewn_at = None;
     for step in 0..400 {
         solver
-            .step_with(&g.cloth, &mut state, &params, &mut sewing)
+            .step_with(&g.cloth, &mut state, &params, input, &mut sewing)
             .unwrap_or_else(|e| panic!("step {step}: {e}"));
         if sewn_at.is_none() && sewing.done() {
             sewn_at = Some(step);
-            params.gravity = [0.0, -atelier_fabric::STANDARD_GRAVITY, 0.0];
+            input.gravity = [0.0, -atelier_fabric::STANDARD_GRAVITY, 0.0];
         }
         if let Some(s) = sewn_at
             && step > s + 100

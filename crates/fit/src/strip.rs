@@ -13,7 +13,7 @@ use atelier_files::{ErrorKind, InvalidValue};
 use atelier_grid::{ClothTopology, StructuredGrid, TopologyError};
 use atelier_solver::kes::Direction as StripDirection;
 use atelier_solver::{
-    Cloth, ClothError, ClothState, ParamError, PinMotion, Solver, StepError, StepParams,
+    Cloth, ClothError, ClothState, ParamError, PinMotion, Solver, StepError, StepInput, StepParams,
 };
 use nalgebra::{DVector, Vector3};
 
@@ -164,8 +164,7 @@ pub fn turned_strip(
     };
     clamp(&mut cloth, 0.0)?;
     let mut state = ClothState::placed(&cloth, place);
-    let mut params = StepParams {
-        dt: 0.25 * h,
+    let params = StepParams {
         damping: run.damping,
         shape: atelier_solver::ShapeParams {
             tolerance: 1e-8,
@@ -178,7 +177,8 @@ pub fn turned_strip(
         ..StepParams::default()
     };
     params.validate()?;
-    let g = params.gravity;
+    let full = StepInput::new(0.25 * h);
+    full.validate()?;
     let mut solver = Solver::new();
     let rate = run.rate_deg_s.to_radians();
     let mut beta = 0.0f64;
@@ -188,13 +188,16 @@ pub fn turned_strip(
         let start = state.time;
         loop {
             let f = (state.time / run.load_time).min(1.0);
-            params.gravity = g.map(|c| c * f);
+            let input = StepInput {
+                gravity: full.gravity.map(|c| c * f),
+                ..full
+            };
             if beta < target {
-                beta = (beta + rate * params.dt).min(target);
+                beta = (beta + rate * input.dt).min(target);
                 clamp(&mut cloth, beta)?;
             }
             solver
-                .step(&cloth, &mut state, &params)
+                .step(&cloth, &mut state, &params, input)
                 .map_err(|source| StripError::Step {
                     clamp_deg: beta.to_degrees(),
                     source,

@@ -41,7 +41,9 @@ use std::time::{Duration, Instant};
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StageTimings, StepParams, StepReport};
+use atelier_solver::{
+    Cloth, ClothState, PinMotion, Solver, StageTimings, StepInput, StepParams, StepReport,
+};
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::Vector3;
 
@@ -135,16 +137,18 @@ struct Fixture {
     state: ClothState,
     solver: Solver,
     params: StepParams,
+    /// Δt 0.01 s under gravity.
+    input: StepInput,
 }
 
 impl Fixture {
     fn new(fabric: &Fabric, side: usize) -> Self {
         let (cloth, mut state) = sheet_scene(fabric, side);
-        let params = StepParams::default();
+        let (params, input) = (StepParams::default(), StepInput::default());
         let mut solver = Solver::new();
         for _ in 0..WARM_UP_STEPS {
             solver
-                .step(&cloth, &mut state, &params)
+                .step(&cloth, &mut state, &params, input)
                 .expect("warm-up step");
         }
         let fixture = Self {
@@ -153,6 +157,7 @@ impl Fixture {
             state,
             solver,
             params,
+            input,
         };
         fixture.check();
         fixture
@@ -172,7 +177,7 @@ impl Fixture {
         let mut solver = Solver::new();
         let mut state = self.state.clone();
         let r = solver
-            .step(&self.cloth, &mut state, &self.params)
+            .step(&self.cloth, &mut state, &self.params, self.input)
             .unwrap_or_else(|e| panic!("{}² sheet: {e}", self.side));
         assert!(
             r.max_strain_error.is_finite() && r.max_strain_error < MAX_STRAIN_ERROR,
@@ -187,7 +192,7 @@ impl Fixture {
             self.side,
             r.max_speed
         );
-        assert!((state.time - (WARM_UP_STEPS + 1) as f64 * self.params.dt).abs() < 1e-9);
+        assert!((state.time - (WARM_UP_STEPS + 1) as f64 * self.input.dt).abs() < 1e-9);
     }
 }
 
@@ -236,10 +241,10 @@ fn median_duration(reports: &[StepReport], field: impl Fn(&StageTimings) -> Dura
 fn stage_medians(fixture: &Fixture, steps: usize) -> StageMedians {
     let mut solver = Solver::new();
     let mut state = fixture.state.clone();
-    let (cloth, params) = (&fixture.cloth, &fixture.params);
-    solver.step(cloth, &mut state, params).expect("step");
+    let (cloth, params, input) = (&fixture.cloth, &fixture.params, fixture.input);
+    solver.step(cloth, &mut state, params, input).expect("step");
     let reports: Vec<StepReport> = (0..steps)
-        .map(|_| solver.step(cloth, &mut state, params).expect("step"))
+        .map(|_| solver.step(cloth, &mut state, params, input).expect("step"))
         .collect();
     let edges = fixture.edges();
     let per_edge_iteration = |time: Duration, iterations: usize| {
@@ -373,11 +378,11 @@ fn party(c: &mut Criterion) {
         let mut fixture: Option<Fixture> = None;
         g.bench_function(nodes.to_string(), |b| {
             let fx = fixture.get_or_insert_with(|| Fixture::new(&fabric, side));
-            let (cloth, params) = (&fx.cloth, &fx.params);
+            let (cloth, params, input) = (&fx.cloth, &fx.params, fx.input);
             let (start, solver) = (&fx.state, &mut fx.solver);
             b.iter_batched(
                 || start.clone(),
-                |mut state| solver.step(cloth, &mut state, params).expect("step"),
+                |mut state| solver.step(cloth, &mut state, params, input).expect("step"),
                 BatchSize::LargeInput,
             )
         });
@@ -418,7 +423,7 @@ fn baselines(c: &mut Criterion) {
     const SIDE: usize = 52;
     let fabric = cotton();
     let measuring = measuring();
-    let warm_up_time = WARM_UP_STEPS as f64 * StepParams::default().dt;
+    let warm_up_time = WARM_UP_STEPS as f64 * StepInput::default().dt;
     let (cloth, start) = sheet_scene(&fabric, SIDE);
     let nodes = cloth.topology().node_count();
 
@@ -427,24 +432,24 @@ fn baselines(c: &mut Criterion) {
 
     // Mass-spring Verlet at 0.9 × its estimated stability limit (a safe lower bound of the
     // true limit), rounded down to a whole number of steps per warm-up.
-    let mut ms_params = MassSpringParams {
+    let ms_params = MassSpringParams {
         bending: true,
         ..MassSpringParams::default()
     };
     let limit = MassSpring::largest_stable_dt_estimate(&cloth, &ms_params);
     let ms_steps = (warm_up_time / (0.9 * limit)).ceil() as usize;
-    ms_params.dt = warm_up_time / ms_steps as f64;
+    let ms_input = StepInput::default().with_dt(warm_up_time / ms_steps as f64);
     let mut ms_state = start.clone();
     let mut ms_solver = MassSpring::new();
     for _ in 0..ms_steps {
         ms_solver
-            .step(&cloth, &mut ms_state, &ms_params)
+            .step(&cloth, &mut ms_state, &ms_params, ms_input)
             .expect("mass-spring warm-up");
     }
     {
         let (mut s, mut st) = (ms_solver.clone(), ms_state.clone());
         let r = s
-            .step(&cloth, &mut st, &ms_params)
+            .step(&cloth, &mut st, &ms_params, ms_input)
             .expect("mass-spring step");
         assert!(r.max_strain.is_finite() && r.max_strain < 0.2, "{r:?}");
         assert!(r.max_speed > 0.05, "mass-spring not moving: {r:?}");
@@ -459,12 +464,14 @@ fn baselines(c: &mut Criterion) {
     let mut xp_solver = Xpbd::new();
     for _ in 0..WARM_UP_STEPS {
         xp_solver
-            .step(&cloth, &mut xp_state, &xp_params)
+            .step(&cloth, &mut xp_state, &xp_params, StepInput::default())
             .expect("xpbd warm-up");
     }
     {
         let (mut s, mut st) = (xp_solver.clone(), xp_state.clone());
-        let r = s.step(&cloth, &mut st, &xp_params).expect("xpbd step");
+        let r = s
+            .step(&cloth, &mut st, &xp_params, StepInput::default())
+            .expect("xpbd step");
         assert!(r.max_strain.is_finite() && r.max_strain < 0.2, "{r:?}");
         assert!(r.max_speed > 0.05, "xpbd not moving: {r:?}");
     }
@@ -482,7 +489,11 @@ fn baselines(c: &mut Criterion) {
             ran = true;
             b.iter_batched(
                 || party.state.clone(),
-                |mut state| solver.step(&party.cloth, &mut state, params).expect("step"),
+                |mut state| {
+                    solver
+                        .step(&party.cloth, &mut state, params, party.input)
+                        .expect("step")
+                },
                 BatchSize::LargeInput,
             )
         });
@@ -492,7 +503,10 @@ fn baselines(c: &mut Criterion) {
         b.iter_batched(
             || (ms_solver.clone(), ms_state.clone()),
             |(mut s, mut state)| {
-                black_box(s.step(&cloth, &mut state, &ms_params).expect("step"));
+                black_box(
+                    s.step(&cloth, &mut state, &ms_params, ms_input)
+                        .expect("step"),
+                );
                 (s, state)
             },
             BatchSize::LargeInput,
@@ -503,7 +517,10 @@ fn baselines(c: &mut Criterion) {
         b.iter_batched(
             || (xp_solver.clone(), xp_state.clone()),
             |(mut s, mut state)| {
-                black_box(s.step(&cloth, &mut state, &xp_params).expect("step"));
+                black_box(
+                    s.step(&cloth, &mut state, &xp_params, StepInput::default())
+                        .expect("step"),
+                );
                 (s, state)
             },
             BatchSize::LargeInput,
@@ -522,7 +539,7 @@ fn baselines(c: &mut Criterion) {
         median_step_time(steps, || {
             black_box(
                 solver
-                    .step(&party.cloth, &mut state, &party.params)
+                    .step(&party.cloth, &mut state, &party.params, party.input)
                     .expect("step"),
             );
         })
@@ -530,13 +547,19 @@ fn baselines(c: &mut Criterion) {
     let ms_step = {
         let (mut s, mut state) = (ms_solver.clone(), ms_state.clone());
         median_step_time(steps * 20, || {
-            black_box(s.step(&cloth, &mut state, &ms_params).expect("step"));
+            black_box(
+                s.step(&cloth, &mut state, &ms_params, ms_input)
+                    .expect("step"),
+            );
         })
     };
     let xp_step = {
         let (mut s, mut state) = (xp_solver.clone(), xp_state.clone());
         median_step_time(steps, || {
-            black_box(s.step(&cloth, &mut state, &xp_params).expect("step"));
+            black_box(
+                s.step(&cloth, &mut state, &xp_params, StepInput::default())
+                    .expect("step"),
+            );
         })
     };
     let per_centisecond = |step: Duration, dt: f64| step.mul_f64(0.01 / dt);
@@ -545,13 +568,13 @@ fn baselines(c: &mut Criterion) {
          Mass-spring Δt = {:.3e} s (estimated stability limit {:.3e} s); XPBD Δt 0.01 s, {} \
          substeps × {} sweeps; PARTY defaults. Medians of {steps} steps.\n\n\
          | solver | Δt s | ms per step | ms per 0.01 s simulated | vs PARTY |\n|---|---|---|---|---|\n",
-        ms_params.dt, limit, xp_params.substeps, xp_params.iterations,
+        ms_input.dt, limit, xp_params.substeps, xp_params.iterations,
     );
-    let party_cs = per_centisecond(party_step, party.params.dt);
+    let party_cs = per_centisecond(party_step, party.input.dt);
     for (name, step, dt) in [
-        ("PARTY", party_step, party.params.dt),
-        ("mass-spring Verlet", ms_step, ms_params.dt),
-        ("XPBD", xp_step, xp_params.dt),
+        ("PARTY", party_step, party.input.dt),
+        ("mass-spring Verlet", ms_step, ms_input.dt),
+        ("XPBD", xp_step, StepInput::default().dt),
     ] {
         let cs = per_centisecond(step, dt);
         let _ = writeln!(
@@ -717,7 +740,7 @@ fn scaling_row(side: usize) -> (usize, usize, f64, f64, f64) {
                     let mut state = fx.state.clone();
                     let t0 = Instant::now();
                     fx.solver
-                        .step(&fx.cloth, &mut state, &fx.params)
+                        .step(&fx.cloth, &mut state, &fx.params, fx.input)
                         .expect("step");
                     times.push(t0.elapsed().as_secs_f64());
                     black_box(&state);
@@ -768,7 +791,7 @@ fn peer_scene(
     for k in 1..=steps {
         let t0 = Instant::now();
         solver
-            .step(&cloth, &mut state, &params)
+            .step(&cloth, &mut state, &params, StepInput::default())
             .map_err(|e| (format!("step {k}: {e}"), state.time))?;
         wall += t0.elapsed().as_secs_f64();
         if k % 10 == 0 {

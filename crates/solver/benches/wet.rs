@@ -16,7 +16,7 @@ use atelier_fabric::Fabric;
 use atelier_solver::baselines::{MassSpring, MassSpringParams};
 use atelier_solver::wet::scene::{WetScene, YamadaParams, yamada_springs};
 use atelier_solver::wet::{PlaneHook, YamadaExtras};
-use atelier_solver::{ClothState, Solver, StepParams};
+use atelier_solver::{ClothState, Solver, StepInput, StepParams};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn satin() -> Fabric {
@@ -37,8 +37,8 @@ fn wet(c: &mut Criterion) {
 
     // Yamada: 0.3 s of warm-up, then stepping on.
     let yp = YamadaParams::default();
+    let y_input = StepInput::new(yp.dt);
     let params = MassSpringParams {
-        dt: yp.dt,
         damping: yp.damping,
         ..MassSpringParams::default()
     };
@@ -47,22 +47,19 @@ fn wet(c: &mut Criterion) {
     let mut ys: ClothState = start.clone();
     for _ in 0..3600 {
         yamada
-            .step_with_extras(&cloth, &mut ys, &params, &mut extras)
+            .step_with_extras(&cloth, &mut ys, &params, y_input, &mut extras)
             .expect("yamada warm-up");
     }
 
     // PARTY: 0.3 s of warm-up at 5 ms.
-    let pp = StepParams {
-        dt: 0.005,
-        ..StepParams::default()
-    };
+    let (pp, p_input) = (StepParams::default(), StepInput::new(0.005));
     let mut party = Solver::new();
     party.pressure = scene.pressure_stage(&cloth);
     let mut hook = PlaneHook { contact };
     let mut ps = start.clone();
     for _ in 0..60 {
         party
-            .step_with(&cloth, &mut ps, &pp, &mut hook)
+            .step_with(&cloth, &mut ps, &pp, p_input, &mut hook)
             .expect("party warm-up");
     }
 
@@ -79,20 +76,20 @@ fn wet(c: &mut Criterion) {
         let stage = party.pressure.as_mut().expect("pressure on");
         let mut v = ps.velocities.clone();
         g.bench_function("pressure_projection", |b| {
-            b.iter(|| stage.project(&ps.positions, cloth.inverse_masses(), pp.dt, &mut v));
+            b.iter(|| stage.project(&ps.positions, cloth.inverse_masses(), p_input.dt, &mut v));
         });
     }
     g.bench_function("yamada_step", |b| {
         b.iter(|| {
             yamada
-                .step_with_extras(&cloth, &mut ys, &params, &mut extras)
+                .step_with_extras(&cloth, &mut ys, &params, y_input, &mut extras)
                 .expect("yamada step")
         });
     });
     g.bench_function("party_step", |b| {
         b.iter(|| {
             party
-                .step_with(&cloth, &mut ps, &pp, &mut hook)
+                .step_with(&cloth, &mut ps, &pp, p_input, &mut hook)
                 .expect("party step")
         });
     });

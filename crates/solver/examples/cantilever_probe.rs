@@ -5,7 +5,7 @@
 
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::{BendingModel, Cloth, ClothState, PinMotion, Solver, StepParams};
+use atelier_solver::{BendingModel, Cloth, ClothState, PinMotion, Solver, StepInput, StepParams};
 use nalgebra::Vector3;
 
 fn main() {
@@ -49,8 +49,8 @@ fn main() {
             cloth.pin(node as u32, p, PinMotion::Fixed).expect("pin");
         }
         let mut state = ClothState::placed(&cloth, place);
+        let input = StepInput::new(get("dt", 0.005));
         let params = StepParams {
-            dt: get("dt", 0.005),
             damping: get("damping", 1.0),
             hysteresis: get("hysteresis", 0.0) != 0.0,
             shape: atelier_solver::ShapeParams {
@@ -74,7 +74,7 @@ fn main() {
         let mut vmax = 0.0;
         let mut calm_since: Option<f64> = None;
         while state.time < get("max_time", 6.0) {
-            match solver.step(&cloth, &mut state, &params) {
+            match solver.step(&cloth, &mut state, &params, input) {
                 Ok(r) => {
                     if !r.converged && get("verbose", 0.0) != 0.0 {
                         println!(
@@ -108,10 +108,7 @@ fn main() {
             }
         }
         if let Some(dt2) = args.iter().find_map(|a| a.strip_prefix("then_dt=")) {
-            let p2 = StepParams {
-                dt: dt2.parse().expect("dt"),
-                ..params.clone()
-            };
+            let input2 = input.with_dt(dt2.parse().expect("dt"));
             let tip = (state.positions[2 * nv - 1] + state.positions[2 * nv - 2]) * 0.5;
             println!(
                 "  before switch: chord {:.4}°",
@@ -119,9 +116,11 @@ fn main() {
             );
             let t1 = state.time;
             while state.time < t1 + 2.0 {
-                let r = solver.step(&cloth, &mut state, &p2).expect("step");
+                let r = solver
+                    .step(&cloth, &mut state, &params, input2)
+                    .expect("step");
                 let tip = (state.positions[2 * nv - 1] + state.positions[2 * nv - 2]) * 0.5;
-                if ((state.time - t1) / 0.25).fract() < p2.dt / 0.25 {
+                if ((state.time - t1) / 0.25).fract() < input2.dt / 0.25 {
                     println!(
                         "  t {:.3} chord {:.4}° vmax {:.2e} viol {:.1e} its {}",
                         state.time,

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_solver::scenes::{DrapeScene, RestCriterion, run_drape};
-use atelier_solver::{ShapeMethod, ShearMeasure, Solver, StepParams};
+use atelier_solver::{ShapeMethod, ShearMeasure, Solver, StepInput, StepParams};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -58,8 +58,8 @@ fn main() {
         "direct0" => ShapeMethod::Direct { refactor_after: 0 },
         _ => ShapeMethod::DEFAULT,
     };
+    let input = StepInput::new(get("dt", 0.01));
     let params = StepParams {
-        dt: get("dt", 0.01),
         hysteresis: get("hysteresis", 1.0) != 0.0,
         damping: get("damping", 0.2),
         divergence_strain: get("divergence", 1.0),
@@ -93,13 +93,15 @@ fn main() {
         ..RestCriterion::default()
     };
     if get("verbose", 0.0) != 0.0 {
-        let steps = (get("max_time", 6.0) / params.dt).round() as usize;
+        let steps = (get("max_time", 6.0) / input.dt).round() as usize;
         for _ in 0..steps {
             if state.time < get("from", 0.0) - 1e-9 {
-                solver.step(&cloth, &mut state, &params).expect("step");
+                solver
+                    .step(&cloth, &mut state, &params, input)
+                    .expect("step");
                 continue;
             }
-            match solver.step(&cloth, &mut state, &params) {
+            match solver.step(&cloth, &mut state, &params, input) {
                 Ok(r) => println!(
                     "t {:.3} conv {} viol {:.2e} {:?} shape its {} fact {} lin {} internal {} {:.1e} {} bending {} {:.1e} vmax {:.3} ke {:.2e}",
                     state.time,
@@ -126,7 +128,15 @@ fn main() {
         return;
     }
     let t0 = Instant::now();
-    let run = run_drape(&scene, &cloth, &mut state, &mut solver, &params, &stop);
+    let run = run_drape(
+        &scene,
+        &cloth,
+        &mut state,
+        &mut solver,
+        &params,
+        input,
+        &stop,
+    );
     let wall = t0.elapsed();
     match run {
         Ok(run) => {

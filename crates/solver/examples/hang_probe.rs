@@ -3,7 +3,7 @@
 
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams, Tension};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepInput, StepParams, Tension};
 use nalgebra::Vector3;
 
 fn main() {
@@ -26,9 +26,9 @@ fn main() {
         cloth.pin(node as u32, p, PinMotion::Fixed).expect("pin");
     }
     let mut state = ClothState::placed(&cloth, place);
+    let input = StepInput::new(std::env::var("DT").map_or(0.01, |v| v.parse().expect("dt")));
     let params = StepParams {
         damping: 1.0,
-        dt: std::env::var("DT").map_or(0.01, |v| v.parse().expect("dt")),
         hysteresis: !args.iter().any(|a| a == "nohyst"),
         internal: atelier_solver::InternalParams {
             tension: if balance {
@@ -75,7 +75,7 @@ fn main() {
                 edge.kind, edge.a, edge.b, state.positions[edge.a as usize]
             );
         }
-        match solver.step(&cloth, &mut state, &params) {
+        match solver.step(&cloth, &mut state, &params, input) {
             Ok(r) => println!(
                 "target strain [{:.3e}, {:.3e}] T [{:.3e}, {:.3e}] t {:.3} conv {} viol {:.2e} {:?} its {} fact {} lin {} vmax {:.3} strain err {:.2e}",
                 solver

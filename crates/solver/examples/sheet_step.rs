@@ -11,7 +11,7 @@ use std::path::Path;
 
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepInput, StepParams};
 use nalgebra::Vector3;
 
 const FABRIC: &str = concat!(
@@ -33,16 +33,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cloth.pin(node as u32, Vector3::new(x, y, 0.0), PinMotion::Fixed)?;
     }
     let mut state = ClothState::flat(&cloth, 0.0);
-    let params = StepParams::default();
+    let (params, input) = (StepParams::default(), StepInput::default());
     let mut solver = Solver::new();
 
-    let steps = (0.5 / params.dt).round() as usize;
+    let steps = (0.5 / input.dt).round() as usize;
     let (mut unconverged, mut worst_violation, mut iterations) = (0, 0.0_f64, 0);
     // Every 10th step's report: shape iterations, the relative constraint violation it ended
     // with (|l − l̄|/l⁰ of the edges, rad for the cells), the fastest node, the kinetic energy.
     println!("   t (s)  shape its  violation  max speed (m/s)  kinetic energy (mJ)");
     for k in 1..=steps {
-        let r = solver.step(&cloth, &mut state, &params)?;
+        let r = solver.step(&cloth, &mut state, &params, input)?;
         unconverged += usize::from(!r.converged);
         worst_violation = worst_violation.max(r.violation);
         iterations += r.shape_iterations;

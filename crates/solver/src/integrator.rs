@@ -10,19 +10,11 @@
 
 use crate::baselines::{BaselineReport, MassSpring, MassSpringParams, Xpbd, XpbdParams};
 use crate::cloth::Cloth;
+pub use crate::params::StepInput;
 use crate::params::StepParams;
 use crate::state::ClothState;
 use crate::step::{CollisionHook, Solver, StepError, StepReport};
 use nalgebra::Vector3;
-
-/// What a step is given besides the cloth and its state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepInput {
-    /// Time step, s.
-    pub dt: f64,
-    /// Gravity, m/s² (the scene's frame).
-    pub gravity: [f64; 3],
-}
 
 /// A cloth integrator: one step of the cloth with a collision hook.
 pub trait Integrator: Send {
@@ -59,7 +51,7 @@ pub trait Integrator: Send {
 pub struct Party {
     /// The step's buffers and state.
     pub solver: Solver,
-    /// Its parameters (their `dt` and `gravity` are set from each step's input).
+    /// Its parameters.
     pub params: StepParams,
 }
 
@@ -75,9 +67,8 @@ impl Integrator for Party {
         input: StepInput,
         hook: &mut dyn CollisionHook,
     ) -> Result<StepReport, StepError> {
-        self.params.dt = input.dt;
-        self.params.gravity = input.gravity;
-        self.solver.step_with(cloth, state, &self.params, hook)
+        self.solver
+            .step_with(cloth, state, &self.params, input, hook)
     }
 
     fn has_tolerance(&self) -> bool {
@@ -90,15 +81,15 @@ impl Integrator for Party {
     }
 }
 
-/// A baseline integrator with its parameters behind [`Integrator`]: its Δt and gravity set
-/// from each step's input, its report converted (both baselines step alike).
+/// A baseline integrator with its parameters behind [`Integrator`], its report converted
+/// (both baselines step alike).
 macro_rules! baseline_integrator {
     ($(#[$doc:meta])* $name:ident, $solver:ty, $params:ty, $label:literal) => {
         $(#[$doc])*
         pub struct $name {
             /// The integrator.
             pub solver: $solver,
-            /// Its parameters (their `dt` and `gravity` are set from each step's input).
+            /// Its parameters.
             pub params: $params,
         }
 
@@ -114,10 +105,8 @@ macro_rules! baseline_integrator {
                 input: StepInput,
                 hook: &mut dyn CollisionHook,
             ) -> Result<StepReport, StepError> {
-                self.params.dt = input.dt;
-                self.params.gravity = input.gravity;
                 self.solver
-                    .step_with(cloth, state, &self.params, hook)
+                    .step_with(cloth, state, &self.params, input, hook)
                     .map(StepReport::from)
             }
         }
@@ -207,7 +196,7 @@ mod tests {
         for integrator in &mut integrators {
             // The mass-spring model is explicit: its own default Δt (the others take 5 ms).
             let dt = match integrator.name() {
-                "mass_spring" => MassSpringParams::default().dt,
+                "mass_spring" => 1.0 / 12000.0,
                 _ => 0.005,
             };
             let input = StepInput {
@@ -222,30 +211,15 @@ mod tests {
                     .advance(&cloth, &mut through_trait, input, &mut NoCollision)
                     .expect("step through the trait");
                 match integrator.name() {
-                    "party" => {
-                        let p = StepParams {
-                            dt: input.dt,
-                            gravity: input.gravity,
-                            ..StepParams::default()
-                        };
-                        party.step(&cloth, &mut direct, &p).map(|_| ())
-                    }
-                    "xpbd" => {
-                        let p = XpbdParams {
-                            dt: input.dt,
-                            gravity: input.gravity,
-                            ..XpbdParams::default()
-                        };
-                        xpbd.step(&cloth, &mut direct, &p).map(|_| ())
-                    }
-                    _ => {
-                        let p = MassSpringParams {
-                            dt: input.dt,
-                            gravity: input.gravity,
-                            ..MassSpringParams::default()
-                        };
-                        spring.step(&cloth, &mut direct, &p).map(|_| ())
-                    }
+                    "party" => party
+                        .step(&cloth, &mut direct, &StepParams::default(), input)
+                        .map(|_| ()),
+                    "xpbd" => xpbd
+                        .step(&cloth, &mut direct, &XpbdParams::default(), input)
+                        .map(|_| ()),
+                    _ => spring
+                        .step(&cloth, &mut direct, &MassSpringParams::default(), input)
+                        .map(|_| ()),
                 }
                 .expect("direct step");
             }

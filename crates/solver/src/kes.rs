@@ -27,7 +27,7 @@ use atelier_grid::{ClothTopology, StructuredGrid, TopologyError};
 use nalgebra::Vector3;
 
 use crate::cloth::{Cloth, ClothError, PinMotion};
-use crate::params::{ShapeParams, StepParams};
+use crate::params::{ShapeParams, StepInput, StepParams};
 use crate::state::ClothState;
 use crate::step::{Solver, StepError};
 
@@ -74,9 +74,10 @@ fn counted_step(
     cloth: &Cloth,
     state: &mut ClothState,
     params: &StepParams,
+    input: StepInput,
 ) -> Result<(), StepError> {
     let start = state.time;
-    let r = solver.step(cloth, state, params)?;
+    let r = solver.step(cloth, state, params, input)?;
     stats.add(&r, params, start);
     Ok(())
 }
@@ -178,13 +179,12 @@ fn fb1_specimen_on(
     Ok((cloth, state))
 }
 
-/// Step parameters of the instruments: no gravity (the specimen lies in the instrument's
-/// plane), the physical air damping, one shape pass (no collisions) solved to `tolerance` —
-/// the clamps read the constraint forces, so the constraints must be met.
-fn instrument_params(dt: f64, tolerance: f64) -> StepParams {
+/// Step parameters of the instruments: the physical air damping, one shape pass (no
+/// collisions) solved to `tolerance` — the clamps read the constraint forces, so the
+/// constraints must be met. The instruments step without gravity (the specimen lies in the
+/// instrument's plane): [`StepInput::weightless`].
+fn instrument_params(tolerance: f64) -> StepParams {
     StepParams {
-        dt,
-        gravity: [0.0; 3],
         shape: ShapeParams {
             collision_passes: 1,
             tolerance,
@@ -316,7 +316,7 @@ pub fn fb1_tensile_test(
     let (mut cloth, mut state) = fb1_specimen(fabric, form, direction)?;
     let top: Vec<usize> = ((nv - 1) * nu..nv * nu).collect();
     place_clamp(&mut cloth, &top, V3::zeros())?;
-    let params = instrument_params(protocol.dt, 1e-7);
+    let (params, input) = (instrument_params(1e-7), StepInput::weightless(protocol.dt));
     let mut solver = Solver::new();
     let fm = protocol.max_force;
     let de = protocol.strain_rate * protocol.dt;
@@ -332,8 +332,8 @@ pub fn fb1_tensile_test(
                        strain: f64|
      -> Result<f64, KesError> {
         place_clamp(cloth, &top, V3::new(0.0, strain * gauge, 0.0))?;
-        counted_step(&mut stats, solver, cloth, state, &params)?;
-        let (f, _) = clamp_reaction(solver, params.dt, &state.positions, &top, V3::zeros());
+        counted_step(&mut stats, solver, cloth, state, &params, input)?;
+        let (f, _) = clamp_reaction(solver, input.dt, &state.positions, &top, V3::zeros());
         // The specimen pulls the top clamp back (−y): the instrument reads that pull.
         Ok(-f.y / width)
     };
@@ -544,7 +544,8 @@ pub fn shear_test(
         fb1_specimen_on(fabric, form, Direction::Warp, nu, nv, width, gauge)?;
     let top: Vec<usize> = ((nv - 1) * nu..nv * nu).collect();
     place_clamp(&mut cloth, &top, V3::zeros())?;
-    let params = instrument_params(protocol.dt, protocol.tolerance);
+    let params = instrument_params(protocol.tolerance);
+    let input = StepInput::weightless(protocol.dt);
     let mut solver = Solver::new();
     let t = protocol.tension;
     // The servo's gain: the specimen's stiffness across the clamps at the pretension, on the
@@ -562,8 +563,8 @@ pub fn shear_test(
                        y: f64|
      -> Result<(f64, f64), KesError> {
         place_clamp(cloth, &top, V3::new(d, y - gauge, 0.0))?;
-        counted_step(&mut stats, solver, cloth, state, &params)?;
-        let (f, _) = clamp_reaction(solver, params.dt, &state.positions, &top, V3::zeros());
+        counted_step(&mut stats, solver, cloth, state, &params, input)?;
+        let (f, _) = clamp_reaction(solver, input.dt, &state.positions, &top, V3::zeros());
         // The shear force: what holds the clamp against the specimen along its motion (the
         // specimen pulls it back, −x); the pull across the clamps (−y).
         Ok((-f.x / width, -f.y / width))
@@ -735,7 +736,7 @@ pub fn bending_test(
     let mut state = ClothState::placed(&cloth, |[x, y]| V3::new(x, y, 0.0));
     let kmax = units::KES_MAX_CURVATURE;
     let dt = (kmax / (0.5 * units::CURVATURE)) / per_leg as f64;
-    let params = instrument_params(dt, 1e-7);
+    let (params, input) = (instrument_params(1e-7), StepInput::weightless(dt));
     let mut solver = Solver::new();
     let leg = |a: f64, b: f64, n: usize| (1..=n).map(move |i| a + (b - a) * i as f64 / n as f64);
     let path: Vec<(usize, f64)> = leg(0.0, kmax, per_leg)
@@ -748,7 +749,7 @@ pub fn bending_test(
     let mut max_force: f64 = 0.0;
     for (pass, k) in path {
         let edge = place_moving(&mut cloth, k)?;
-        counted_step(&mut stats, &mut solver, &cloth, &mut state, &params)?;
+        counted_step(&mut stats, &mut solver, &cloth, &mut state, &params, input)?;
         let (f, m) = clamp_reaction(&solver, dt, &state.positions, &moving, edge);
         max_force = max_force.max(f.norm() / width);
         // The specimen's moment on the clamp about x; the instrument holds it with the opposite.

@@ -20,7 +20,7 @@ use atelier_grid::{ClothTopology, StructuredGrid};
 
 use crate::cloth::{Cloth, ClothOptions, PinMotion};
 use crate::contact::BodyContact;
-use crate::params::StepParams;
+use crate::params::{StepInput, StepParams};
 use crate::scenes::SceneError;
 use crate::state::ClothState;
 use crate::step::{Solver, StepError};
@@ -131,11 +131,11 @@ pub fn run_leg(scene: &LegScene, fabric: &Fabric) -> Result<LegRun, LegError> {
     let (leg, tris) = cylinder(scene.leg_radius, scene.leg_length, 24, 17);
     let mut contact = BodyContact::new(&cloth, scene.contact)?;
     let mut distance = BodyDistance::new(&leg, &tris)?;
-    // The body frame has y up (the solver's default gravity points along −z).
-    let params = StepParams {
+    // The body frame has y up.
+    let params = StepParams::default();
+    let input = StepInput {
         dt: scene.dt,
         gravity: [0.0, -atelier_fabric::STANDARD_GRAVITY, 0.0],
-        ..StepParams::default()
     };
     let mut solver = Solver::new();
     let steps = (scene.duration / scene.dt).round() as usize;
@@ -162,7 +162,7 @@ pub fn run_leg(scene: &LegScene, fabric: &Fabric) -> Result<LegRun, LegError> {
         }
         let t0 = Instant::now();
         contact.set_body(&start, &end, &tris, scene.dt)?;
-        let report = solver.step_with(&cloth, &mut state, &params, &mut contact)?;
+        let report = solver.step_with(&cloth, &mut state, &params, input, &mut contact)?;
         run.wall += t0.elapsed();
         run.collision += report.timings.collision + report.timings.transfer;
         let stats = contact.take_stats();

@@ -33,7 +33,7 @@ pub use cloth::{Cloth, ClothError, ClothOptions, Incidence, Pin, PinMotion};
 pub use contact::BodyContact;
 pub use params::{
     BendingModel, BendingParams, ConstraintKind, InternalMethod, InternalParams, ParamError,
-    ShapeMethod, ShapeParams, ShearParams, StepParams, Tension, TolerancePolicy,
+    ShapeMethod, ShapeParams, ShearParams, StepInput, StepParams, Tension, TolerancePolicy,
 };
 pub use shear_angle::ShearMeasure;
 pub use state::ClothState;

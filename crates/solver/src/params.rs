@@ -133,10 +133,6 @@ pub enum TolerancePolicy {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct StepParams {
-    /// Time step Δt, s. Range (0, 0.1]; default 0.01 (the thesis's).
-    pub dt: f64,
-    /// Gravity, m/s². Default (0, 0, −9.80665).
-    pub gravity: [f64; 3],
     /// Linear damping per area c/S (air drag and internal friction), kg/(m²·s). Range [0, 1e3];
     /// default 0.2 (a light fabric's terminal speed of a few m/s; a physical value, not a
     /// convergence aid — see `docs/solver.md`).
@@ -165,8 +161,6 @@ pub struct StepParams {
 impl Default for StepParams {
     fn default() -> Self {
         Self {
-            dt: 0.01,
-            gravity: [0.0, 0.0, -atelier_fabric::STANDARD_GRAVITY],
             damping: 0.2,
             internal: InternalParams::default(),
             shape: ShapeParams::default(),
@@ -353,12 +347,64 @@ pub(crate) fn check(
     }
 }
 
-/// The fields every solver's parameters share: Δt, gravity and damping.
-pub(crate) fn check_motion(dt: f64, gravity: [f64; 3], damping: f64) -> Result<(), ParamError> {
-    check("dt", dt, dt > 0.0 && dt <= 0.1, "(0, 0.1] s")?;
-    for g in gravity {
-        check("gravity", g, g.abs() <= 1e3, "|g| ≤ 1000 m/s²")?;
+/// What a step is given besides the cloth, its state and the integrator's parameters: the
+/// time step and gravity, which change from step to step (a garment is sewn without gravity
+/// and settles with it; a step that misses its tolerance is taken again in halves). Every
+/// integrator takes them with each step; none stores them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepInput {
+    /// Time step Δt, s. Range (0, 0.1].
+    pub dt: f64,
+    /// Gravity, m/s² (the scene's frame). Each component within ±1000.
+    pub gravity: [f64; 3],
+}
+
+impl StepInput {
+    /// Δt under standard gravity along −z (the solver tests' and instruments' frame).
+    pub fn new(dt: f64) -> Self {
+        Self {
+            dt,
+            gravity: [0.0, 0.0, -atelier_fabric::STANDARD_GRAVITY],
+        }
     }
+
+    /// Δt without gravity.
+    pub fn weightless(dt: f64) -> Self {
+        Self {
+            dt,
+            gravity: [0.0; 3],
+        }
+    }
+
+    /// The same gravity with another Δt.
+    pub fn with_dt(self, dt: f64) -> Self {
+        Self { dt, ..self }
+    }
+
+    /// Gravity as a vector.
+    pub fn gravity_vector(&self) -> Vector3<f64> {
+        Vector3::from(self.gravity)
+    }
+
+    /// Check Δt and gravity against their ranges.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        check("dt", self.dt, self.dt > 0.0 && self.dt <= 0.1, "(0, 0.1] s")?;
+        for g in self.gravity {
+            check("gravity", g, g.abs() <= 1e3, "|g| ≤ 1000 m/s²")?;
+        }
+        Ok(())
+    }
+}
+
+impl Default for StepInput {
+    /// 0.01 s (the thesis's Δt) under standard gravity along −z.
+    fn default() -> Self {
+        Self::new(0.01)
+    }
+}
+
+/// The damping every integrator's parameters have.
+pub(crate) fn check_damping(damping: f64) -> Result<(), ParamError> {
     check(
         "damping",
         damping,
@@ -370,7 +416,7 @@ pub(crate) fn check_motion(dt: f64, gravity: [f64; 3], damping: f64) -> Result<(
 impl StepParams {
     /// Check every field against its range.
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_motion(self.dt, self.gravity, self.damping)?;
+        check_damping(self.damping)?;
         check(
             "internal.step",
             self.internal.step,
@@ -472,11 +518,6 @@ impl StepParams {
         Ok(())
     }
 
-    /// Gravity as a vector.
-    pub fn gravity_vector(&self) -> Vector3<f64> {
-        Vector3::from(self.gravity)
-    }
-
     /// The tolerance factor (≥ 1) for a cloth whose fastest node moves at `max_speed` m/s.
     pub fn tolerance_factor(&self, max_speed: f64) -> f64 {
         match self.tolerance_policy {
@@ -500,11 +541,16 @@ mod tests {
     #[test]
     fn defaults_are_valid_and_ranges_are_enforced() {
         StepParams::default().validate().expect("defaults valid");
-        let bad = StepParams {
-            dt: 0.0,
-            ..StepParams::default()
-        };
+        StepInput::default()
+            .validate()
+            .expect("default input valid");
+        let bad = StepInput::new(0.0);
         assert_eq!(bad.validate().expect_err("dt").name, "dt");
+        let bad = StepInput {
+            gravity: [0.0, 2e3, 0.0],
+            ..StepInput::default()
+        };
+        assert_eq!(bad.validate().expect_err("gravity").name, "gravity");
         let bad = StepParams {
             shape: ShapeParams {
                 method: ShapeMethod::Chebyshev { rho: 1.0 },

@@ -19,7 +19,7 @@ use nalgebra::Vector3;
 
 use crate::cloth::{Cloth, ClothError, ClothOptions, PinMotion};
 use crate::metrics::{FoldPeak, NodeCountParams, Shadow, fold_peaks, radial_profile};
-use crate::params::StepParams;
+use crate::params::{StepInput, StepParams};
 use crate::state::ClothState;
 use crate::step::{Solver, StepError};
 
@@ -397,7 +397,7 @@ fn max_strain(cloth: &Cloth, state: &ClothState, axial: bool) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
-/// Step `state` with `solver` and `params` until the cloth is at rest by `stop` or reaches
+/// Step `state` with `solver`, `params` and `input` (Δt and gravity) until the cloth is at rest by `stop` or reaches
 /// its time cap, then measure the drape with `scene`. The rest test uses the kinetic energy of
 /// the free nodes per free mass, ½·v_rms²: the cloth is at rest when v_rms stays below
 /// `stop.rest_speed` for `stop.hold_time` after `stop.min_time`. (Kinetic energy alone can
@@ -409,11 +409,12 @@ pub fn run_drape(
     state: &mut ClothState,
     solver: &mut Solver,
     params: &StepParams,
+    input: StepInput,
     stop: &RestCriterion,
 ) -> Result<DrapeRun, StepError> {
     let mut wall = Duration::ZERO;
     let mut steps = 0;
-    let mut watch = RestWatch::new(*stop, params.dt);
+    let mut watch = RestWatch::new(*stop, input.dt);
     let mut settled = false;
     let mut max_strain_error: f64 = 0.0;
     let mut shape_iterations = 0usize;
@@ -421,7 +422,7 @@ pub fn run_drape(
     let mut max_violation: f64 = 0.0;
     let mut trace = Vec::new();
     let mut next_sample = stop.sample_interval;
-    let eps = 1e-9 * params.dt;
+    let eps = 1e-9 * input.dt;
     let sample = |state: &ClothState| {
         let m = scene.measure(cloth, state);
         DrapeSample {
@@ -434,7 +435,7 @@ pub fn run_drape(
     };
     while state.time < stop.max_time - eps {
         let t0 = Instant::now();
-        let report = solver.step(cloth, state, params)?;
+        let report = solver.step(cloth, state, params, input)?;
         wall += t0.elapsed();
         steps += 1;
         max_strain_error = max_strain_error.max(report.max_strain_error);

@@ -25,7 +25,8 @@ use anyhow::{Context, Result};
 use atelier_fabric::Fabric;
 use atelier_solver::StepParams;
 use atelier_solver::wet::scene::{
-    Springs, WetRun, WetScene, WetSolver, YamadaParams, largest_dt_where, largest_stable_dt, run,
+    Springs, WetPartyParams, WetRun, WetScene, WetSolver, YamadaParams, largest_dt_where,
+    largest_stable_dt, run,
 };
 use plotters::prelude::*;
 
@@ -58,9 +59,9 @@ fn yamada(dt: f64) -> WetSolver {
 }
 
 fn party(dt: f64) -> WetSolver {
-    WetSolver::Party(StepParams {
+    WetSolver::Party(WetPartyParams {
         dt,
-        ..StepParams::default()
+        ..WetPartyParams::default()
     })
 }
 
@@ -224,17 +225,19 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     }
     // Cheaper PARTY steps: fewer iterations (time against error).
     for (dt, cap) in [(0.005, 10), (0.005, 5), (0.01, 5)] {
-        let cheap = WetSolver::Party(StepParams {
+        let cheap = WetSolver::Party(WetPartyParams {
             dt,
-            shape: atelier_solver::ShapeParams {
-                max_iterations: cap,
-                ..atelier_solver::ShapeParams::default()
+            step: StepParams {
+                shape: atelier_solver::ShapeParams {
+                    max_iterations: cap,
+                    ..atelier_solver::ShapeParams::default()
+                },
+                internal: atelier_solver::InternalParams {
+                    max_iterations: cap,
+                    ..atelier_solver::InternalParams::default()
+                },
+                ..StepParams::default()
             },
-            internal: atelier_solver::InternalParams {
-                max_iterations: cap,
-                ..atelier_solver::InternalParams::default()
-            },
-            ..StepParams::default()
         });
         let name = format!("PARTY step, 2 threads, ≤ {cap} shape and {cap} internal iterations");
         rows.push((name, run_on(2, &full, &fabric, &cheap)?));

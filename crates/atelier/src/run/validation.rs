@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use atelier_fabric::{AnisotropyForm, Fabric};
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::scenes::{DrapeScene, RestCriterion, RestWatch, rms_speed};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepInput, StepParams};
 use nalgebra::Vector3;
 
 use super::to_y_up;
@@ -64,11 +64,12 @@ impl Stepper {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &StepParams,
+        input: StepInput,
     ) -> bool {
         self.last_good.copy_from_slice(&state.positions);
         let t = state.time;
         let clock = Instant::now();
-        let result = solver.step(cloth, state, params);
+        let result = solver.step(cloth, state, params, input);
         self.wall += clock.elapsed();
         match result {
             Ok(r) => {
@@ -81,7 +82,7 @@ impl Stepper {
                 });
                 self.max_strain_error = self.max_strain_error.max(r.max_strain_error);
                 self.max_speed = r.max_speed;
-                if state.time + 1e-9 * params.dt >= self.next_frame {
+                if state.time + 1e-9 * input.dt >= self.next_frame {
                     self.frames
                         .push(state.time, state.positions.iter().map(to_y_up).collect());
                     self.next_frame += self.interval;
@@ -164,19 +165,17 @@ pub(super) fn drape(
     let (cloth, mut state) = scene
         .build(fabric)
         .map_err(RunError::setup("drape scene"))?;
-    let params = StepParams {
-        dt: spec.dt.unwrap_or(dt),
-        ..spec.step.clone()
-    };
+    let (params, input) = (spec.step.clone(), StepInput::new(spec.dt.unwrap_or(dt)));
     params.validate().map_err(RunError::setup("drape scene"))?;
+    input.validate().map_err(RunError::setup("drape scene"))?;
     // The rest criterion of `run_drape` (RestCriterion::default()).
-    let mut watch = RestWatch::new(RestCriterion::default(), params.dt);
-    let eps = 1e-9 * params.dt;
+    let mut watch = RestWatch::new(RestCriterion::default(), input.dt);
+    let eps = 1e-9 * input.dt;
     let mut stepper = Stepper::new(&state, spec.frame_interval);
     let mut solver = Solver::new();
     let mut settled = false;
     while state.time < spec.max_time - eps {
-        if !stepper.step(&mut solver, &cloth, &mut state, &params) {
+        if !stepper.step(&mut solver, &cloth, &mut state, &params, input) {
             break;
         }
         progress(state.time / spec.max_time);
@@ -210,7 +209,7 @@ pub(super) fn drape(
         scene.support_radius(),
         1.2 * (scene.specimen_radius() - scene.support_radius()),
     );
-    let mut sim = stepper.into_simulated(&cloth, &state, params.dt, Some(support), metrics);
+    let mut sim = stepper.into_simulated(&cloth, &state, input.dt, Some(support), metrics);
     sim.warnings.extend(warnings);
     Ok(sim)
 }
@@ -318,17 +317,18 @@ pub(super) fn cantilever(
     let mut state = ClothState::placed(&cloth, place);
     // Implicit bending keeps this stable up to about 0.4·h s/m; 0.25·h leaves a margin.
     let params = StepParams {
-        dt: 0.25 * h,
         damping: spec.damping,
         hysteresis: spec.hysteresis,
         ..StepParams::default()
     };
+    let input = StepInput::new(0.25 * h);
     params.validate().map_err(RunError::setup(SCENE))?;
+    input.validate().map_err(RunError::setup(SCENE))?;
     let mut stepper = Stepper::new(&state, spec.frame_interval);
     let mut solver = Solver::new();
     let mut at_rest = false;
     while state.time < spec.max_time {
-        if !stepper.step(&mut solver, &cloth, &mut state, &params) {
+        if !stepper.step(&mut solver, &cloth, &mut state, &params, input) {
             break;
         }
         progress(state.time / spec.max_time);
@@ -357,7 +357,7 @@ pub(super) fn cantilever(
         [0.0, width + 0.01, 0.0],
         "platform",
     );
-    let mut sim = stepper.into_simulated(&cloth, &state, params.dt, Some(platform), metrics);
+    let mut sim = stepper.into_simulated(&cloth, &state, input.dt, Some(platform), metrics);
     if !at_rest && ok {
         sim.warnings.push(format!(
             "not at rest after {:.2} s (fastest node {:.2e} m/s)",
@@ -429,8 +429,9 @@ pub(super) fn catenary(
         }
     }
     let mut state = ClothState::placed(&cloth, place);
+    let input = StepInput::new(spec.dt);
+    input.validate().map_err(RunError::setup(SCENE))?;
     let params = StepParams {
-        dt: spec.dt,
         damping: spec.damping,
         bending: atelier_solver::BendingParams {
             off: true,
@@ -443,7 +444,7 @@ pub(super) fn catenary(
     let mut solver = Solver::new();
     let steps = (spec.duration / spec.dt).round() as usize;
     for _ in 0..steps {
-        if !stepper.step(&mut solver, &cloth, &mut state, &params) {
+        if !stepper.step(&mut solver, &cloth, &mut state, &params, input) {
             break;
         }
         progress(state.time / spec.duration);
@@ -469,7 +470,7 @@ pub(super) fn catenary(
     );
     metrics.insert("sag_m".into(), ok.then_some(sag));
     metrics.insert("max_speed_m_s".into(), ok.then_some(stepper.max_speed));
-    Ok(stepper.into_simulated(&cloth, &state, params.dt, None, metrics))
+    Ok(stepper.into_simulated(&cloth, &state, input.dt, None, metrics))
 }
 
 /// The two recorded frames of a virtual KES test: the specimen at rest and at the end.

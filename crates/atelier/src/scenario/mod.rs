@@ -645,14 +645,14 @@ impl Scenario {
                     .chain(w.compare.as_ref().map(|c| ("kind.compare", c)))
                 {
                     let checked = match solver {
-                        WetSolver::Party(p) => p.validate(),
+                        WetSolver::Party(p) => p.step.validate(),
                         WetSolver::Yamada(y) => atelier_solver::baselines::MassSpringParams {
-                            dt: y.dt,
                             damping: y.damping,
                             ..Default::default()
                         }
                         .validate(),
-                    };
+                    }
+                    .and_then(|()| atelier_solver::StepInput::new(solver.dt()).validate());
                     checked.map_err(|e| {
                         InvalidValue::new(ErrorKind::OutOfRange, field, e.to_string())
                     })?;

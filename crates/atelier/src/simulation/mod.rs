@@ -27,9 +27,7 @@ use atelier_solver::baselines::{MassSpring, Xpbd};
 use atelier_solver::integrator::{
     Integrator, MassSpringIntegrator, Party, StepInput, XpbdIntegrator,
 };
-use atelier_solver::{
-    BodyContact, ClothState, Solver, StageTimings, StepError, StepParams, StepReport,
-};
+use atelier_solver::{BodyContact, ClothState, Solver, StageTimings, StepError, StepReport};
 use serde::{Deserialize, Serialize};
 
 use crate::place::place;
@@ -252,11 +250,7 @@ impl Simulation {
         )?;
         // Standing: the same pose at both ends of the step.
         contact.set_part_motion(&start_pose, &start_pose, settings.dt)?;
-        let params = StepParams {
-            dt: settings.dt,
-            gravity: [0.0; 3],
-            ..settings.step.clone()
-        };
+        let params = settings.step.clone();
         let integrator: Box<dyn Integrator> = match &settings.solver {
             ClothSolver::Party => Box::new(Party {
                 solver: Solver::new(),

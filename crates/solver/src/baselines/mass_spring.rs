@@ -37,7 +37,7 @@ use super::{
     first_non_finite, non_finite, report, resize,
 };
 use crate::cloth::Cloth;
-use crate::params::{ParamError, check, check_motion};
+use crate::params::{ParamError, StepInput, check, check_damping};
 use crate::state::ClothState;
 use crate::step::{CollisionHook, NoCollision, Stage, StageTimings, StepError};
 
@@ -45,11 +45,6 @@ use crate::step::{CollisionHook, NoCollision, Stage, StageTimings, StepError};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MassSpringParams {
-    /// Time step Δt, s. Range (0, 0.1]; default 1/12000 (Yamada's reference experiment). Must
-    /// also lie below [`MassSpring::largest_stable_dt_estimate`] for the run to stay bounded.
-    pub dt: f64,
-    /// Gravity, m/s². Default (0, 0, −9.80665).
-    pub gravity: [f64; 3],
     /// Linear damping per area c (force −c·S·ṙ on a node of area S), kg/(m²·s). Range
     /// [0, 1000]; default 0.2 (as [`crate::StepParams::damping`]).
     pub damping: f64,
@@ -72,8 +67,6 @@ pub struct MassSpringParams {
 impl Default for MassSpringParams {
     fn default() -> Self {
         Self {
-            dt: 1.0 / 12000.0,
-            gravity: [0.0, 0.0, -atelier_fabric::STANDARD_GRAVITY],
             damping: 0.2,
             reference_force_fraction: 0.01,
             bending: false,
@@ -86,7 +79,7 @@ impl Default for MassSpringParams {
 impl MassSpringParams {
     /// Check every field against its range.
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_motion(self.dt, self.gravity, self.damping)?;
+        check_damping(self.damping)?;
         check(
             "reference_force_fraction",
             self.reference_force_fraction,
@@ -107,14 +100,9 @@ impl MassSpringParams {
         )
     }
 
-    /// The length of one Verlet step, Δt/substeps, s.
-    pub fn substep(&self) -> f64 {
-        self.dt / self.substeps as f64
-    }
-
-    /// Gravity as a vector.
-    pub fn gravity_vector(&self) -> V3 {
-        V3::from(self.gravity)
+    /// The length of one Verlet step of a step of `dt`, Δt/substeps, s.
+    pub fn substep(&self, dt: f64) -> f64 {
+        dt / self.substeps as f64
     }
 }
 
@@ -208,8 +196,9 @@ impl MassSpring {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &MassSpringParams,
+        input: StepInput,
     ) -> Result<BaselineReport, StepError> {
-        self.step_full(cloth, state, params, &mut NoExtras, &mut NoCollision)
+        self.step_full(cloth, state, params, input, &mut NoExtras, &mut NoCollision)
     }
 
     /// One step with a scene's extra forces and contacts. On error the state is unchanged.
@@ -218,9 +207,10 @@ impl MassSpring {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &MassSpringParams,
+        input: StepInput,
         extras: &mut dyn SpringExtras,
     ) -> Result<BaselineReport, StepError> {
-        self.step_full(cloth, state, params, extras, &mut NoCollision)
+        self.step_full(cloth, state, params, input, extras, &mut NoCollision)
     }
 
     /// One step with a collision hook, as the PARTY step drives it ([`crate::baselines`],
@@ -233,9 +223,10 @@ impl MassSpring {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &MassSpringParams,
+        input: StepInput,
         hook: &mut dyn CollisionHook,
     ) -> Result<BaselineReport, StepError> {
-        self.step_full(cloth, state, params, &mut NoExtras, hook)
+        self.step_full(cloth, state, params, input, &mut NoExtras, hook)
     }
 
     fn step_full(
@@ -243,21 +234,23 @@ impl MassSpring {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &MassSpringParams,
+        input: StepInput,
         extras: &mut dyn SpringExtras,
         hook: &mut dyn CollisionHook,
     ) -> Result<BaselineReport, StepError> {
         let t_start = Instant::now();
         params.validate()?;
+        input.validate()?;
         check_input(cloth, state)?;
         let time = state.time;
-        let h = params.substep();
+        let h = params.substep(input.dt);
         let mut backup = self.backup.take().unwrap_or_default();
         backup.positions.clone_from(&state.positions);
         backup.velocities.clone_from(&state.velocities);
         backup.time = time;
         backup.previous.clone_from(&self.previous);
         backup.history = self.history;
-        let result = self.substeps(cloth, state, params, extras, hook, &backup, h);
+        let result = self.substeps(cloth, state, params, input, extras, hook, &backup, h);
         let out = match result {
             Ok(mut timings) => {
                 let tu = Instant::now();
@@ -290,13 +283,14 @@ impl MassSpring {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &MassSpringParams,
+        input: StepInput,
         extras: &mut dyn SpringExtras,
         hook: &mut dyn CollisionHook,
         start: &Backup,
         h: f64,
     ) -> Result<StageTimings, StepError> {
         let mut timings = StageTimings::default();
-        let (dt, time) = (params.dt, state.time);
+        let (dt, time) = (input.dt, state.time);
         let n = cloth.topology().node_count();
         let inv = cloth.inverse_masses();
 
@@ -333,6 +327,7 @@ impl MassSpring {
                 cloth,
                 state,
                 params,
+                input.gravity_vector(),
                 extras,
                 h,
                 frac,
@@ -376,14 +371,15 @@ impl MassSpring {
         Ok(timings)
     }
 
-    /// One Verlet step of length `h` from the state, committed into it; then the hook's ties
-    /// and planes (`frac` of the step done, `t_left` to its end).
+    /// One Verlet step of length `h` under gravity `g` from the state, committed into it; then
+    /// the hook's ties and planes (`frac` of the step done, `t_left` to its end).
     #[allow(clippy::too_many_arguments)]
     fn verlet(
         &mut self,
         cloth: &Cloth,
         state: &mut ClothState,
         params: &MassSpringParams,
+        g: V3,
         extras: &mut dyn SpringExtras,
         h: f64,
         frac: f64,
@@ -446,7 +442,7 @@ impl MassSpring {
                 time,
             });
         }
-        let (g, c) = (params.gravity_vector(), params.damping);
+        let c = params.damping;
         for (((f, &m), &s), v) in self
             .force
             .iter_mut()

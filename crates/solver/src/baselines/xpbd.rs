@@ -41,7 +41,7 @@ use super::{
     first_non_finite, non_finite, report, resize,
 };
 use crate::cloth::Cloth;
-use crate::params::{ParamError, check, check_motion};
+use crate::params::{ParamError, StepInput, check, check_damping};
 use crate::state::ClothState;
 use crate::step::{CollisionHook, NoCollision, Stage, StepError};
 
@@ -49,10 +49,6 @@ use crate::step::{CollisionHook, NoCollision, Stage, StepError};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct XpbdParams {
-    /// Time step Δt, s. Range (0, 0.1]; default 0.01 (the PARTY default).
-    pub dt: f64,
-    /// Gravity, m/s². Default (0, 0, −9.80665).
-    pub gravity: [f64; 3],
     /// Linear damping per area c (force −c·S·ṙ on a node of area S), kg/(m²·s). Range
     /// [0, 1000]; default 0.2 (as [`crate::StepParams::damping`]).
     pub damping: f64,
@@ -73,8 +69,6 @@ pub struct XpbdParams {
 impl Default for XpbdParams {
     fn default() -> Self {
         Self {
-            dt: 0.01,
-            gravity: [0.0, 0.0, -atelier_fabric::STANDARD_GRAVITY],
             damping: 0.2,
             substeps: 10,
             iterations: 4,
@@ -88,7 +82,7 @@ impl Default for XpbdParams {
 impl XpbdParams {
     /// Check every field against its range.
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_motion(self.dt, self.gravity, self.damping)?;
+        check_damping(self.damping)?;
         check(
             "substeps",
             self.substeps as f64,
@@ -113,11 +107,6 @@ impl XpbdParams {
             (0.0..=1e6).contains(&self.compliance_scale),
             "[0, 1e6]",
         )
-    }
-
-    /// Gravity as a vector.
-    pub fn gravity_vector(&self) -> V3 {
-        V3::from(self.gravity)
     }
 }
 
@@ -150,14 +139,15 @@ impl Xpbd {
         self.history = None;
     }
 
-    /// One step of length Δt (`substeps` substeps). On error the state is unchanged.
+    /// One step of length `input.dt` (`substeps` substeps). On error the state is unchanged.
     pub fn step(
         &mut self,
         cloth: &Cloth,
         state: &mut ClothState,
         params: &XpbdParams,
+        input: StepInput,
     ) -> Result<BaselineReport, StepError> {
-        self.step_with(cloth, state, params, &mut NoCollision)
+        self.step_with(cloth, state, params, input, &mut NoCollision)
     }
 
     /// One step with a collision hook, as the PARTY step drives it ([`crate::baselines`],
@@ -170,15 +160,17 @@ impl Xpbd {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &XpbdParams,
+        input: StepInput,
         hook: &mut dyn CollisionHook,
     ) -> Result<BaselineReport, StepError> {
         let t_start = Instant::now();
         let mut timings = crate::step::StageTimings::default();
         params.validate()?;
+        input.validate()?;
         check_input(cloth, state)?;
         let topo = cloth.topology();
         let (n, edges) = (topo.node_count(), topo.edges());
-        let (dt, time) = (params.dt, state.time);
+        let (dt, time) = (input.dt, state.time);
         fill_stiffness(cloth, params.reference_force_fraction, &mut self.stiffness);
         if params.bending {
             fill_hinges(cloth, &mut self.hinges);
@@ -194,7 +186,7 @@ impl Xpbd {
         self.v.copy_from_slice(&state.velocities);
         let starting = self.history != Some((time.to_bits(), dt.to_bits()));
         let (inv, masses, areas) = (cloth.inverse_masses(), cloth.masses(), topo.node_areas());
-        let (g, c) = (params.gravity_vector(), params.damping);
+        let (g, c) = (input.gravity_vector(), params.damping);
         let h = dt / params.substeps as f64;
         let inv_h2 = 1.0 / (h * h);
         let colours = cloth.colour_count();

@@ -130,8 +130,7 @@ impl Solver {
     }
 
     /// F_sum += μ g + external forces.
-    pub(super) fn add_external(&mut self, cloth: &Cloth, params: &StepParams) {
-        let g = params.gravity_vector();
+    pub(super) fn add_external(&mut self, cloth: &Cloth, g: V3) {
         let masses = cloth.masses();
         let ext = &self.external_forces;
         for (i, f) in self.s.f_sum.iter_mut().enumerate() {

@@ -40,7 +40,7 @@ use atelier_grid::SLOTS;
 use nalgebra::Vector3;
 
 use crate::cloth::Cloth;
-use crate::params::StepParams;
+use crate::params::{StepInput, StepParams};
 use crate::state::ClothState;
 
 pub(crate) use hook::plane_push;
@@ -122,8 +122,9 @@ impl Solver {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &StepParams,
+        input: StepInput,
     ) -> Result<StepReport, StepError> {
-        self.step_with(cloth, state, params, &mut NoCollision)
+        self.step_with(cloth, state, params, input, &mut NoCollision)
     }
 
     /// One step with a collision hook between shape-constraint iterations.
@@ -132,15 +133,16 @@ impl Solver {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &StepParams,
+        input: StepInput,
         hook: &mut dyn CollisionHook,
     ) -> Result<StepReport, StepError> {
         if cloth.topology().edges().len() >= PAR_MIN {
             // Run the whole step on a pool thread: the parallel loops inside then split work
             // by stealing instead of each injecting a job from outside the pool (measured:
             // ~20 % of a 1 681-node step went to thread hand-offs).
-            rayon::scope(|_| self.step_inner(cloth, state, params, hook))
+            rayon::scope(|_| self.step_inner(cloth, state, params, input, hook))
         } else {
-            self.step_inner(cloth, state, params, hook)
+            self.step_inner(cloth, state, params, input, hook)
         }
     }
 
@@ -151,25 +153,26 @@ impl Solver {
         cloth: &Cloth,
         state: &mut ClothState,
         params: &StepParams,
+        input: StepInput,
         hook: &mut dyn CollisionHook,
     ) -> Result<StepReport, StepError> {
-        report::check_input(cloth, state, params)?;
+        report::check_input(cloth, state, params, input)?;
         self.size(cloth);
         let mut report = StepReport::default();
-        let (dt, time) = (params.dt, state.time);
+        let (dt, time) = (input.dt, state.time);
 
         // 1. Geometry and bending.
         let t0 = Instant::now();
         self.geometry(cloth, state);
         self.bending(cloth, state, params);
-        self.add_external(cloth, params);
+        self.add_external(cloth, input.gravity_vector());
         guard_nodes(Stage::Bending, "bending force", &self.s.f_sum, time)?;
         report.timings.bending = t0.elapsed();
 
         // 1b. The air pressure force (a wet cloth only).
         if self.pressure.is_some() {
             let t0 = Instant::now();
-            self.pressure_force(cloth, state, params);
+            self.pressure_force(cloth, state, params, dt);
             guard_nodes(Stage::Pressure, "pressure force", &self.s.f_sum, time)?;
             report.timings.pressure = t0.elapsed();
         }
@@ -188,7 +191,7 @@ impl Solver {
         // 3. Unconstrained velocity.
         let t0 = Instant::now();
         (report.bending_iterations, report.bending_residual) =
-            self.unconstrained_velocity(cloth, state, params);
+            self.unconstrained_velocity(cloth, state, params, dt);
         guard_nodes(Stage::Velocity, "velocity", &self.s.vel, time)?;
         report.timings.velocity = t0.elapsed();
 
@@ -214,6 +217,7 @@ impl Solver {
             cloth,
             state,
             params,
+            dt,
             report.tolerance_factor,
             hook,
             &mut report,
@@ -229,7 +233,7 @@ impl Solver {
         self.predict_positions(state, dt);
         guard_nodes(Stage::Update, "position", &self.s.pred, time)?;
         self.check_divergence(cloth, params, time)?;
-        self.commit(cloth, state, params);
+        self.commit(cloth, state, params, dt);
         report.max_strain_error = self.max_strain_error(cloth, state, params);
         report.kinetic_energy = state.kinetic_energy(cloth);
         report.max_speed = max_speed(&state.velocities);

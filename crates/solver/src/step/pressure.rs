@@ -15,11 +15,11 @@ impl Solver {
         cloth: &Cloth,
         state: &ClothState,
         params: &StepParams,
+        dt: f64,
     ) {
         let Some(p) = &mut self.pressure else {
             return;
         };
-        let dt = params.dt;
         // The pressure predicted for the end of the step (backward Euler) from the
         // velocities the other forces would give.
         let (mass, areas, f) = (cloth.masses(), cloth.topology().node_areas(), &self.s.f_sum);

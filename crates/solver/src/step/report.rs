@@ -6,7 +6,7 @@ use std::time::Duration;
 use super::V3;
 use super::projection::Constraint;
 use crate::cloth::Cloth;
-use crate::params::{ParamError, StepParams};
+use crate::params::{ParamError, StepInput, StepParams};
 use crate::state::ClothState;
 
 /// The stages of a step, for timings and errors.
@@ -232,8 +232,10 @@ pub(super) fn check_input(
     cloth: &Cloth,
     state: &ClothState,
     params: &StepParams,
+    input: StepInput,
 ) -> Result<(), StepError> {
     params.validate()?;
+    input.validate()?;
     let topo = cloth.topology();
     let (n, ne) = (topo.node_count(), topo.edges().len());
     for (what, expected, found) in [

@@ -25,11 +25,12 @@ impl Solver {
         cloth: &Cloth,
         state: &ClothState,
         params: &StepParams,
+        dt: f64,
         factor: f64,
         hook: &mut dyn CollisionHook,
         report: &mut StepReport,
     ) -> Result<(), StepError> {
-        let (dt, time) = (params.dt, state.time);
+        let time = state.time;
         let tol = params.shape.tolerance * factor;
         let local = !params.shape.method.is_global();
         self.prepare_long_range(cloth, params, local);

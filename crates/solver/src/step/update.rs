@@ -68,7 +68,13 @@ impl Solver {
 
     /// Commit the step to the state: positions, velocities (plus the contacts' exit velocities),
     /// axial forces, shear angles, hysteresis states, time.
-    pub(super) fn commit(&mut self, cloth: &Cloth, state: &mut ClothState, params: &StepParams) {
+    pub(super) fn commit(
+        &mut self,
+        cloth: &Cloth,
+        state: &mut ClothState,
+        params: &StepParams,
+        dt: f64,
+    ) {
         std::mem::swap(&mut state.positions, &mut self.s.pred);
         for ((v, w), e) in state
             .velocities
@@ -81,7 +87,7 @@ impl Solver {
         if params.internal.tension == Tension::Constraint {
             // This step's constraint forces: what the next step's targets read, and the force
             // at which the tensile hysteresis is committed.
-            self.projection.edge_forces(params.dt, &mut self.s.p);
+            self.projection.edge_forces(dt, &mut self.s.p);
             let (widths, edges, p) = (cloth.edge_widths(), cloth.topology().edges(), &self.s.p);
             fill(&mut self.s.force_per_width, |e| {
                 if edges[e].kind.is_axial() {
@@ -106,7 +112,7 @@ impl Solver {
         });
         state.shear_angle.copy_from_slice(&self.s.shear);
         self.commit_hysteresis(cloth, state, params);
-        state.time += params.dt;
+        state.time += dt;
     }
 
     /// Commit the hysteresis states at this step's forces, curvatures and shear angles.

@@ -19,8 +19,8 @@ impl Solver {
         cloth: &Cloth,
         state: &ClothState,
         params: &StepParams,
+        dt: f64,
     ) -> (usize, f64) {
-        let dt = params.dt;
         let (mass, areas) = (cloth.masses(), cloth.topology().node_areas());
         let axial = cloth.bending_neighbours();
         let implicit = params.bending.implicit

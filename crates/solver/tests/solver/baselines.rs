@@ -9,7 +9,7 @@ use atelier_solver::baselines::{
     BaselineReport, MassSpring, MassSpringParams, Xpbd, XpbdParams, secant_modulus,
     spring_stiffnesses,
 };
-use atelier_solver::{Cloth, ClothState, PinMotion, Stage, StepError};
+use atelier_solver::{Cloth, ClothState, PinMotion, Stage, StepError, StepInput};
 use nalgebra::Vector3;
 
 use crate::common::fabric;
@@ -68,12 +68,15 @@ fn run_mass_spring(
     cloth: &Cloth,
     state: &mut ClothState,
     params: &MassSpringParams,
+    dt: f64,
     steps: usize,
 ) -> BaselineReport {
     let mut solver = MassSpring::new();
     let mut report = BaselineReport::default();
     for _ in 0..steps {
-        report = solver.step(cloth, state, params).expect("mass-spring step");
+        report = solver
+            .step(cloth, state, params, StepInput::new(dt))
+            .expect("mass-spring step");
     }
     report
 }
@@ -83,12 +86,15 @@ fn run_xpbd(
     cloth: &Cloth,
     state: &mut ClothState,
     params: &XpbdParams,
+    dt: f64,
     steps: usize,
 ) -> BaselineReport {
     let mut solver = Xpbd::new();
     let mut report = BaselineReport::default();
     for _ in 0..steps {
-        report = solver.step(cloth, state, params).expect("XPBD step");
+        report = solver
+            .step(cloth, state, params, StepInput::new(dt))
+            .expect("XPBD step");
     }
     report
 }
@@ -178,14 +184,14 @@ fn free_fall_matches_the_parabola() {
         z.chain(v).fold(0.0, f64::max)
     };
     let params = MassSpringParams {
-        dt: 1e-4,
         damping: 0.0,
         bending: true,
         ..MassSpringParams::default()
     };
+    let dt = 1e-4;
     let mut state = start.clone();
-    run_mass_spring(&cloth, &mut state, &params, 1000);
-    let err = worst(&state, params.dt);
+    run_mass_spring(&cloth, &mut state, &params, dt, 1000);
+    let err = worst(&state, dt);
     assert!(err < 1e-9, "mass-spring free fall off by {err:e}");
 
     let params = XpbdParams {
@@ -193,9 +199,10 @@ fn free_fall_matches_the_parabola() {
         bending: true,
         ..XpbdParams::default()
     };
+    let dt = 0.01;
     let mut state = start;
-    run_xpbd(&cloth, &mut state, &params, 10);
-    let err = worst(&state, params.dt / params.substeps as f64);
+    run_xpbd(&cloth, &mut state, &params, dt, 10);
+    let err = worst(&state, dt / params.substeps as f64);
     assert!(err < 1e-9, "XPBD free fall off by {err:e}");
 }
 
@@ -221,23 +228,23 @@ fn free_fall_with_linear_drag_matches_the_exponential() {
         }
     };
     let params = MassSpringParams {
-        dt: 1e-4,
         damping: c,
         ..MassSpringParams::default()
     };
+    let dt = 1e-4;
     let mut state = start.clone();
-    run_mass_spring(&cloth, &mut state, &params, 5000);
-    check(&state, params.dt, "mass-spring");
+    run_mass_spring(&cloth, &mut state, &params, dt, 5000);
+    check(&state, dt, "mass-spring");
 
     let params = XpbdParams {
-        dt: 1e-3,
         substeps: 1,
         damping: c,
         ..XpbdParams::default()
     };
+    let dt = 1e-3;
     let mut state = start;
-    run_xpbd(&cloth, &mut state, &params, 500);
-    check(&state, params.dt, "XPBD");
+    run_xpbd(&cloth, &mut state, &params, dt, 500);
+    check(&state, dt, "XPBD");
 }
 
 /// A strip 2 × 11 nodes, 1 cm spacing, hanging from its top row, with linear fabric (E = 100 N/m
@@ -265,11 +272,10 @@ fn mass_spring_hanging_strip_has_the_static_extension_of_its_springs() {
     let fab = linear_fabric(&base, e, e * 1e-6);
     let (cloth, mut state) = hanging_strip(&fab, 2, nv, h, h * (nv - 1) as f64);
     let params = MassSpringParams {
-        dt: 1e-4,
         damping: 2.5,
         ..MassSpringParams::default()
     };
-    let report = run_mass_spring(&cloth, &mut state, &params, 10_000);
+    let report = run_mass_spring(&cloth, &mut state, &params, 1e-4, 10_000);
     assert!(report.max_speed < 1e-4, "not at rest: {report:?}");
     let err = strip_extension_error(&state, base.mass_per_area, e, h, nv);
     assert!(err < 1e-3, "extension off by {err:e} relative");
@@ -293,7 +299,7 @@ fn xpbd_hanging_strip_converges_to_the_compliant_extension() {
         ..XpbdParams::default()
     };
     let mut state = start.clone();
-    let report = run_xpbd(&cloth, &mut state, &converged, 100);
+    let report = run_xpbd(&cloth, &mut state, &converged, 0.01, 100);
     assert!(report.max_speed < 1e-6, "not at rest: {report:?}");
     let err = strip_extension_error(&state, base.mass_per_area, e, h, nv);
     assert!(err < 1e-3, "converged extension off by {err:e} relative");
@@ -304,7 +310,7 @@ fn xpbd_hanging_strip_converges_to_the_compliant_extension() {
         ..converged
     };
     let mut state = start;
-    run_xpbd(&cloth, &mut state, &loose, 100);
+    run_xpbd(&cloth, &mut state, &loose, 0.01, 100);
     let err = strip_extension_error(&state, base.mass_per_area, e, h, nv);
     assert!(
         err > 0.1,
@@ -329,7 +335,7 @@ fn xpbd_hard_constraints_become_inextensible_as_iterations_increase() {
             ..XpbdParams::default()
         };
         let mut state = start.clone();
-        run_xpbd(&cloth, &mut state, &params, 300).max_strain
+        run_xpbd(&cloth, &mut state, &params, 0.01, 300).max_strain
     };
     let series: Vec<f64> = [4, 16, 64, 256].iter().map(|&it| strain(1, it)).collect();
     for pair in series.windows(2) {
@@ -386,20 +392,18 @@ fn bending_hinges_reproduce_the_small_deflection_cantilever() {
             ..MassSpringParams::default()
         };
         let dt = 0.5 * MassSpring::largest_stable_dt_estimate(cloth, &params);
-        let params = MassSpringParams { dt, ..params };
-        let report = run_mass_spring(cloth, state, &params, (0.3 / dt) as usize);
+        let report = run_mass_spring(cloth, state, &params, dt, (0.3 / dt) as usize);
         assert!(report.max_speed < 1e-6, "not at rest: {report:?}");
     };
     let xpbd = |cloth: &Cloth, state: &mut ClothState| {
         let params = XpbdParams {
             bending: true,
             damping: 50.0,
-            dt: 1e-3,
             substeps: 50,
             iterations: 50,
             ..XpbdParams::default()
         };
-        run_xpbd(cloth, state, &params, 300);
+        run_xpbd(cloth, state, &params, 1e-3, 300);
     };
     let r: Vec<f64> = [11, 21, 41]
         .iter()
@@ -440,15 +444,11 @@ fn mass_spring_stability_estimate_is_safe_and_within_a_factor_two() {
         };
         let estimate = MassSpring::largest_stable_dt_estimate(&cloth, &params);
         let stable = |dt: f64| {
-            let params = MassSpringParams {
-                dt,
-                ..params.clone()
-            };
             let mut state = start.clone();
             let mut solver = MassSpring::new();
             (0..3000).all(|_| {
                 solver
-                    .step(&cloth, &mut state, &params)
+                    .step(&cloth, &mut state, &params, StepInput::new(dt))
                     .is_ok_and(|r| r.max_strain < 0.5)
             })
         };
@@ -477,15 +477,12 @@ fn mass_spring_stability_estimate_is_safe_and_within_a_factor_two() {
 #[test]
 fn mass_spring_blow_up_is_an_error_and_leaves_the_state_unchanged() {
     let (cloth, mut state) = hanging_strip(&fabric("denim"), 3, 6, 0.02, 0.05);
-    let params = MassSpringParams {
-        dt: 0.01,
-        ..MassSpringParams::default()
-    };
+    let params = MassSpringParams::default();
     let mut solver = MassSpring::new();
     let n = cloth.topology().node_count();
     for step in 0..1000 {
         let before = state.clone();
-        match solver.step(&cloth, &mut state, &params) {
+        match solver.step(&cloth, &mut state, &params, StepInput::new(0.01)) {
             Ok(_) => {
                 let finite = state
                     .positions
@@ -540,24 +537,23 @@ fn bad_input_is_an_error_and_leaves_the_state_unchanged() {
     let mut cases: Vec<(&str, Step, Step)> = vec![
         (
             "mass-spring",
-            Box::new(|s: &mut ClothState| ms.step(&cloth, s, &ms_params)),
             Box::new(|s: &mut ClothState| {
-                let p = MassSpringParams {
-                    dt: -1.0,
-                    ..MassSpringParams::default()
-                };
-                MassSpring::new().step(&cloth, s, &p)
+                ms.step(&cloth, s, &ms_params, StepInput::new(1.0 / 12000.0))
+            }),
+            Box::new(|s: &mut ClothState| {
+                let p = MassSpringParams::default();
+                MassSpring::new().step(&cloth, s, &p, StepInput::new(-1.0))
             }),
         ),
         (
             "XPBD",
-            Box::new(|s: &mut ClothState| xpbd.step(&cloth, s, &xpbd_params)),
+            Box::new(|s: &mut ClothState| xpbd.step(&cloth, s, &xpbd_params, StepInput::default())),
             Box::new(|s: &mut ClothState| {
                 let p = XpbdParams {
                     iterations: 0,
                     ..XpbdParams::default()
                 };
-                Xpbd::new().step(&cloth, s, &p)
+                Xpbd::new().step(&cloth, s, &p, StepInput::default())
             }),
         ),
     ];
@@ -616,13 +612,10 @@ fn pins_follow_their_motion_and_runs_are_deterministic() {
             .collect()
     };
     let ms_params = MassSpringParams {
-        dt: 5e-5,
-        gravity: [0.0; 3],
         bending: true,
         ..MassSpringParams::default()
     };
     let xpbd_params = XpbdParams {
-        gravity: [0.0; 3],
         bending: true,
         ..XpbdParams::default()
     };
@@ -631,13 +624,15 @@ fn pins_follow_their_motion_and_runs_are_deterministic() {
         let mut a = start.clone();
         let mut ms = MassSpring::new();
         for _ in 0..2000 {
-            ms.step(&cloth, &mut a, &ms_params).expect("step");
+            ms.step(&cloth, &mut a, &ms_params, StepInput::weightless(5e-5))
+                .expect("step");
             assert!((a.positions[0] - pin.position(a.time)).norm() < 1e-12);
         }
         let mut b = start.clone();
         let mut xpbd = Xpbd::new();
         for _ in 0..10 {
-            xpbd.step(&cloth, &mut b, &xpbd_params).expect("step");
+            xpbd.step(&cloth, &mut b, &xpbd_params, StepInput::weightless(0.01))
+                .expect("step");
             assert!((b.positions[0] - pin.position(b.time)).norm() < 1e-12);
         }
         // The far corner has been dragged along (by 3.6 mm; asserted > 2 mm).
@@ -696,19 +691,19 @@ fn hooked_baselines(cloth: &Cloth) -> Vec<(&'static str, HookedStep<'_>)> {
         ..XpbdParams::default()
     };
     let ms = MassSpringParams {
-        dt: 0.01,
         substeps: 100,
         damping: 0.0,
         ..MassSpringParams::default()
     };
-    assert!(MassSpring::largest_stable_dt_estimate(cloth, &ms) > ms.substep());
+    let input = StepInput::new(0.01);
+    assert!(MassSpring::largest_stable_dt_estimate(cloth, &ms) > ms.substep(input.dt));
     let (mut x, mut m) = (Xpbd::new(), MassSpring::new());
     vec![
         (
             "XPBD",
             Box::new(
                 move |s: &mut ClothState, h: &mut dyn atelier_solver::CollisionHook| {
-                    x.step_with(cloth, s, &xp, h).expect("XPBD step")
+                    x.step_with(cloth, s, &xp, input, h).expect("XPBD step")
                 },
             ),
         ),
@@ -716,7 +711,8 @@ fn hooked_baselines(cloth: &Cloth) -> Vec<(&'static str, HookedStep<'_>)> {
             "mass-spring",
             Box::new(
                 move |s: &mut ClothState, h: &mut dyn atelier_solver::CollisionHook| {
-                    m.step_with(cloth, s, &ms, h).expect("mass-spring step")
+                    m.step_with(cloth, s, &ms, input, h)
+                        .expect("mass-spring step")
                 },
             ),
         ),

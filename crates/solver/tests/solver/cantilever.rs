@@ -6,7 +6,7 @@
 
 use atelier_fabric::{AnisotropyForm, Fabric, Spindle, units};
 use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepInput, StepParams};
 use nalgebra::Vector3;
 
 use crate::common::fabric;
@@ -161,7 +161,7 @@ fn simulate(f: &Fabric, along: Along, length: f64, segments: usize, tolerance: f
     let mut at_rest = false;
     while state.time < 20.0 {
         let r = solver
-            .step(&cloth, &mut state, &params)
+            .step(&cloth, &mut state, &params, StepInput::default())
             .unwrap_or_else(|e| panic!("{segments} cells: {e}"));
         steps += 1;
         unconverged += usize::from(!r.converged);
@@ -299,7 +299,7 @@ fn a_hysteretic_strip_comes_to_rest_above_the_elastic_one() {
     let mut fastest = f64::INFINITY;
     while state.time < 5.0 {
         fastest = solver
-            .step(&cloth, &mut state, &params)
+            .step(&cloth, &mut state, &params, StepInput::default())
             .expect("step")
             .max_speed;
     }

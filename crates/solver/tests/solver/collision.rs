@@ -2,6 +2,7 @@
 //! lets no node into the leg at Δt 0.01 s.
 
 use atelier_collide::ContactParams;
+use atelier_solver::StepInput;
 use atelier_solver::leg::{LegScene, run_leg};
 
 use crate::common::fabric;
@@ -126,11 +127,11 @@ fn walking_skirt(
         .iter()
         .map(|(range, t)| BodyDistance::new(&body.rest.vertices[range.clone()], t).expect("closed"))
         .collect();
-    // The body frame has y up (the solver's default gravity points along −z).
-    let params = StepParams {
+    // The body frame has y up.
+    let params = StepParams::default();
+    let input = StepInput {
         dt,
         gravity: [0.0, -atelier_fabric::STANDARD_GRAVITY, 0.0],
-        ..StepParams::default()
     };
     let mut solver = Solver::new();
     let steps = (duration / dt).round() as usize;
@@ -142,7 +143,7 @@ fn walking_skirt(
             .set_body(&a.positions, &b.positions, &tris, dt)
             .expect("body");
         solver
-            .step_with(&cloth, &mut state, &params, &mut contact)
+            .step_with(&cloth, &mut state, &params, input, &mut contact)
             .map_err(|e| format!("step {k}: {e}"))?;
         let stats = contact.take_stats();
         contacts += stats.body_hits + stats.planes;
@@ -307,7 +308,7 @@ fn nudged_step(nudge: fn(usize) -> bool) -> atelier_solver::StepReport {
         nudge,
     };
     Solver::new()
-        .step_with(&cloth, &mut state, &params, &mut hook)
+        .step_with(&cloth, &mut state, &params, StepInput::default(), &mut hook)
         .expect("step")
 }
 

@@ -4,8 +4,8 @@
 use atelier_fabric::AnisotropyForm;
 use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::{
-    Cloth, ClothState, InternalMethod, PinMotion, Solver, StepError, StepParams, Tension,
-    TolerancePolicy,
+    Cloth, ClothState, InternalMethod, PinMotion, Solver, StepError, StepInput, StepParams,
+    Tension, TolerancePolicy,
 };
 use nalgebra::Vector3;
 
@@ -52,10 +52,13 @@ fn hang_with(
         ..StepParams::default()
     };
     let mut solver = Solver::new();
-    let steps = (seconds / params.dt).round() as usize;
+    let input = StepInput::default();
+    let steps = (seconds / input.dt).round() as usize;
     let (mut iterations, mut counted, mut residual) = (0usize, 0usize, 0.0);
     for k in 0..steps {
-        let r = solver.step(&cloth, &mut state, &params).expect("step");
+        let r = solver
+            .step(&cloth, &mut state, &params, input)
+            .expect("step");
         if k + 100 >= steps {
             iterations += r.internal_iterations;
             counted += 1;
@@ -82,6 +85,7 @@ fn long_hanging_cloth_is_at_its_target_strains_and_rows_stay_level() {
                 damping: 1.0,
                 ..StepParams::default()
             },
+            StepInput::default(),
         )
         .expect("step");
     assert!(r.max_speed < 1e-3, "not at rest: {} m/s", r.max_speed);
@@ -159,10 +163,13 @@ fn corner_pinned(side: usize, seconds: f64, long_range: bool) -> (f64, f64) {
         ..StepParams::default()
     };
     let mut solver = Solver::new();
-    let steps = (seconds / params.dt).round() as usize;
+    let input = StepInput::default();
+    let steps = (seconds / input.dt).round() as usize;
     let (mut converged, mut stretch) = (0usize, 0.0f64);
     for _ in 0..steps {
-        let r = solver.step(&cloth, &mut state, &params).expect("step");
+        let r = solver
+            .step(&cloth, &mut state, &params, input)
+            .expect("step");
         converged += usize::from(r.converged);
         stretch = stretch.max(
             atelier_solver::metrics::axial_strains(&cloth, &state.positions)
@@ -247,8 +254,11 @@ fn long_range_attachments_without_pins_change_nothing() {
     let cloth = Cloth::new(topo, &f, AnisotropyForm::Thesis).expect("cloth");
     let run = |long_range| {
         let mut state = ClothState::flat(&cloth, 0.0);
-        let params = StepParams {
+        let input = StepInput {
             gravity: [1.0, 0.0, -9.8],
+            ..StepInput::default()
+        };
+        let params = StepParams {
             shape: atelier_solver::ShapeParams {
                 long_range_attachments: long_range,
                 ..atelier_solver::ShapeParams::default()
@@ -257,7 +267,9 @@ fn long_range_attachments_without_pins_change_nothing() {
         };
         let mut solver = Solver::new();
         for _ in 0..20 {
-            solver.step(&cloth, &mut state, &params).expect("step");
+            solver
+                .step(&cloth, &mut state, &params, input)
+                .expect("step");
         }
         state.positions
     };
@@ -305,8 +317,8 @@ fn stress_never_produces_non_finite_state() {
         let emt = stress_scene(name).2;
         for dt in [0.01, 0.02, 0.05] {
             let (cloth, mut state, _) = stress_scene(name);
+            let input = StepInput::new(dt);
             let params = StepParams {
-                dt,
                 tolerance_policy: TolerancePolicy::Adaptive {
                     loose_factor: 1.5,
                     fast_speed: 1.0,
@@ -332,7 +344,7 @@ fn stress_never_produces_non_finite_state() {
             let mut worst_converged: f64 = 0.0;
             for _ in 0..(1.0 / dt) as usize {
                 let before = state.clone();
-                match solver.step(&cloth, &mut state, &params) {
+                match solver.step(&cloth, &mut state, &params, input) {
                     Ok(report) => {
                         assert!(
                             state
@@ -398,24 +410,18 @@ fn stress_run(name: &str, which: Which, dt: f64) -> Outcome {
     let (cloth, mut state, emt) = stress_scene(name);
     let steps = (0.5 / dt).round() as usize;
     let (mut party, mut ms, mut xp) = (Solver::new(), MassSpring::new(), Xpbd::new());
-    let party_params = StepParams {
-        dt,
-        ..StepParams::default()
-    };
-    let ms_params = MassSpringParams {
-        dt,
-        ..MassSpringParams::default()
-    };
-    let xp_params = XpbdParams {
-        dt,
-        ..XpbdParams::default()
-    };
+    let (party_params, ms_params, xp_params) = (
+        StepParams::default(),
+        MassSpringParams::default(),
+        XpbdParams::default(),
+    );
+    let input = StepInput::new(dt);
     let mut outcome = Outcome::Bounded;
     for _ in 0..steps {
         let ok = match which {
-            Which::Party => party.step(&cloth, &mut state, &party_params).is_ok(),
-            Which::MassSpring => ms.step(&cloth, &mut state, &ms_params).is_ok(),
-            Which::Xpbd => xp.step(&cloth, &mut state, &xp_params).is_ok(),
+            Which::Party => party.step(&cloth, &mut state, &party_params, input).is_ok(),
+            Which::MassSpring => ms.step(&cloth, &mut state, &ms_params, input).is_ok(),
+            Which::Xpbd => xp.step(&cloth, &mut state, &xp_params, input).is_ok(),
         };
         if !ok {
             return Outcome::Error;

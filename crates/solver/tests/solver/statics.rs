@@ -3,7 +3,7 @@
 
 use atelier_fabric::AnisotropyForm;
 use atelier_grid::{ClothTopology, StructuredGrid};
-use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepParams};
+use atelier_solver::{Cloth, ClothState, PinMotion, Solver, StepInput, StepParams};
 use nalgebra::Vector3;
 
 use crate::common::fabric;
@@ -27,13 +27,14 @@ fn free_fall_with_linear_drag_converges_at_first_order() {
     for dt in [0.01, 0.005, 0.0025] {
         let mut state = ClothState::flat(&cloth, 0.0);
         let params = StepParams {
-            dt,
             damping,
             ..StepParams::default()
         };
         let mut solver = Solver::new();
         for _ in 0..(t_end / dt).round() as usize {
-            solver.step(&cloth, &mut state, &params).expect("step");
+            solver
+                .step(&cloth, &mut state, &params, StepInput::new(dt))
+                .expect("step");
         }
         // Rigid fall: every node has the same velocity and drop; no edge stretched.
         for (p, v) in state.positions.iter().zip(&state.velocities) {
@@ -118,8 +119,8 @@ fn hanging_strip_matches_the_catenary() {
         }
     }
     let mut state = ClothState::placed(&cloth, place);
+    let input = StepInput::new(0.005);
     let params = StepParams {
-        dt: 0.005,
         damping: 2.0,
         bending: atelier_solver::BendingParams {
             off: true,
@@ -130,7 +131,11 @@ fn hanging_strip_matches_the_catenary() {
     let mut solver = Solver::new();
     let mut report = None;
     for _ in 0..2000 {
-        report = Some(solver.step(&cloth, &mut state, &params).expect("step"));
+        report = Some(
+            solver
+                .step(&cloth, &mut state, &params, input)
+                .expect("step"),
+        );
     }
     let report = report.expect("ran");
     assert!(
@@ -180,7 +185,9 @@ fn results_do_not_depend_on_the_thread_count() {
             let mut solver = Solver::new();
             let params = StepParams::default();
             for _ in 0..10 {
-                solver.step(&cloth, &mut state, &params).expect("step");
+                solver
+                    .step(&cloth, &mut state, &params, StepInput::default())
+                    .expect("step");
             }
             state
         })

@@ -4,9 +4,11 @@
 
 use std::sync::OnceLock;
 
-use atelier_solver::wet::scene::{Pick, WetRun, WetScene, WetSolver, YamadaParams, run};
+use atelier_solver::wet::scene::{
+    Pick, WetPartyParams, WetRun, WetScene, WetSolver, YamadaParams, run,
+};
 use atelier_solver::wet::{ATMOSPHERE, Bubbles, PlaneContact, PlaneHook, PressureParams};
-use atelier_solver::{Solver, StepParams};
+use atelier_solver::{Solver, StepInput};
 
 use crate::common::fabric;
 
@@ -123,9 +125,9 @@ fn pressure_off_is_the_dry_scene() {
         duration: 0.2,
         ..pinch(1, None)
     };
-    let params = StepParams {
+    let params = WetPartyParams {
         dt: 0.005,
-        ..StepParams::default()
+        ..WetPartyParams::default()
     };
     let wet = run(&scene, &fabric, &WetSolver::Party(params.clone())).expect("scene");
     let (cloth, mut state) = scene.build(&fabric).expect("build");
@@ -139,7 +141,13 @@ fn pressure_off_is_the_dry_scene() {
     };
     for _ in 0..wet.steps {
         solver
-            .step_with(&cloth, &mut state, &params, &mut hook)
+            .step_with(
+                &cloth,
+                &mut state,
+                &params.step,
+                StepInput::new(params.dt),
+                &mut hook,
+            )
             .expect("step");
     }
     assert_eq!(wet.positions, state.positions);
@@ -152,9 +160,9 @@ fn pressure_off_is_the_dry_scene() {
 #[test]
 fn the_party_step_takes_the_pressure_at_60_times_the_step() {
     let fabric = fabric(SATIN);
-    let params = StepParams {
+    let params = WetPartyParams {
         dt: 0.005,
-        ..StepParams::default()
+        ..WetPartyParams::default()
     };
     let party = run(&pinch(1, Some(400.0)), &fabric, &WetSolver::Party(params)).expect("scene");
     assert!(party.failure.is_none(), "{:?}", party.failure);
@@ -218,9 +226,9 @@ fn two_pockets_keep_their_own_air() {
         duration: 0.8,
         ..WetScene::default()
     };
-    let params = StepParams {
+    let params = WetPartyParams {
         dt: 0.005,
-        ..StepParams::default()
+        ..WetPartyParams::default()
     };
     let run = run(&scene, &fabric, &WetSolver::Party(params)).expect("scene");
     assert!(run.failure.is_none(), "{:?}", run.failure);

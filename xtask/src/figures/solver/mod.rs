@@ -42,8 +42,8 @@ use atelier_grid::{ClothTopology, StructuredGrid};
 use atelier_solver::baselines::{MassSpring, MassSpringParams, Xpbd, XpbdParams};
 use atelier_solver::metrics::{DEFAULT_SHADOW_ROWS, Shadow, drape_coefficient};
 use atelier_solver::{
-    Cloth, ClothOptions, ClothState, PinMotion, ShapeMethod, Solver, StepError, StepParams,
-    TolerancePolicy,
+    Cloth, ClothOptions, ClothState, PinMotion, ShapeMethod, Solver, StepError, StepInput,
+    StepParams, TolerancePolicy,
 };
 use plotters::prelude::*;
 
@@ -65,6 +65,8 @@ const R_INNER: f64 = 0.0635;
 const R_OUTER: f64 = 0.3175;
 /// Reference Δt, s; the uncertainty run uses twice this.
 const REFERENCE_DT: f64 = 0.0025;
+/// The XPBD runs' Δt, s (the PARTY default).
+const XPBD_DT: f64 = 0.01;
 /// Runs cheaper than this are repeated (fastest repeat kept)…
 const REPEAT_BELOW: Duration = Duration::from_millis(1500);
 /// …at most this many times in all.
@@ -108,18 +110,17 @@ impl Family {
     }
 }
 
+/// A solver with its parameters and its Δt, s.
 enum Method {
-    Party(Box<StepParams>),
-    MassSpring(MassSpringParams),
-    Xpbd(XpbdParams),
+    Party(Box<StepParams>, f64),
+    MassSpring(MassSpringParams, f64),
+    Xpbd(XpbdParams, f64),
 }
 
 impl Method {
     fn dt(&self) -> f64 {
         match self {
-            Method::Party(p) => p.dt,
-            Method::MassSpring(p) => p.dt,
-            Method::Xpbd(p) => p.dt,
+            Method::Party(_, dt) | Method::MassSpring(_, dt) | Method::Xpbd(_, dt) => *dt,
         }
     }
 }
@@ -217,28 +218,30 @@ fn run_once(cloth: &Cloth, start: &ClothState, method: &Method, steps: usize) ->
     let mut max_strain: f64 = 0.0;
     let (mut it_a, mut it_b) = (0usize, 0usize);
     let t0 = Instant::now();
+    // Standard gravity along −z.
+    let input = StepInput::new(method.dt());
     let result: std::result::Result<(), StepError> = (|| {
         match method {
-            Method::Party(p) => {
+            Method::Party(p, _) => {
                 let mut solver = Solver::new();
                 for _ in 0..steps {
-                    let r = solver.step(cloth, &mut state, p)?;
+                    let r = solver.step(cloth, &mut state, p, input)?;
                     max_strain = max_strain.max(r.max_strain_error);
                     it_a += r.shape_iterations;
                     it_b += r.internal_iterations;
                 }
             }
-            Method::MassSpring(p) => {
+            Method::MassSpring(p, _) => {
                 let mut solver = MassSpring::new();
                 for _ in 0..steps {
-                    let r = solver.step(cloth, &mut state, p)?;
+                    let r = solver.step(cloth, &mut state, p, input)?;
                     max_strain = max_strain.max(r.max_strain);
                 }
             }
-            Method::Xpbd(p) => {
+            Method::Xpbd(p, _) => {
                 let mut solver = Xpbd::new();
                 for _ in 0..steps {
-                    let r = solver.step(cloth, &mut state, p)?;
+                    let r = solver.step(cloth, &mut state, p, input)?;
                     max_strain = max_strain.max(r.max_strain);
                     it_a += r.iterations;
                 }
@@ -249,13 +252,13 @@ fn run_once(cloth: &Cloth, start: &ClothState, method: &Method, steps: usize) ->
     let wall = t0.elapsed();
     let n = steps.max(1) as f64;
     let iterations = match method {
-        Method::Party(_) => format!(
+        Method::Party(..) => format!(
             "shape {:.0}, internal {:.0}",
             it_a as f64 / n,
             it_b as f64 / n
         ),
-        Method::MassSpring(_) => "1 force evaluation".to_owned(),
-        Method::Xpbd(_) => format!("{:.0} sweeps", it_a as f64 / n),
+        Method::MassSpring(..) => "1 force evaluation".to_owned(),
+        Method::Xpbd(..) => format!("{:.0} sweeps", it_a as f64 / n),
     };
     Run {
         outcome: result.map(|()| state.positions.iter().map(|p| [p.x, p.y, p.z]).collect()),
@@ -278,11 +281,10 @@ fn rms_distance(cloth: &Cloth, a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     (sum / count.max(1) as f64).sqrt()
 }
 
-/// The PARTY reference parameters at `dt`: the direct shape solve renewing its factorization
-/// every Newton step, solved to a relative violation of 1e-8 (100 iterations per pass at most).
-fn reference_params(dt: f64) -> StepParams {
+/// The PARTY reference parameters: the direct shape solve renewing its factorization every
+/// Newton step, solved to a relative violation of 1e-8 (100 iterations per pass at most).
+fn reference_params() -> StepParams {
     StepParams {
-        dt,
         shape: atelier_solver::ShapeParams {
             method: ShapeMethod::Direct { refactor_after: 0 },
             tolerance: 1e-8,
@@ -293,12 +295,18 @@ fn reference_params(dt: f64) -> StepParams {
     }
 }
 
+/// A PARTY configuration at the default Δt.
 fn party(sweep: &'static str, setting: String, params: StepParams) -> Config {
+    party_at(sweep, setting, params, StepInput::default().dt)
+}
+
+/// A PARTY configuration at `dt`.
+fn party_at(sweep: &'static str, setting: String, params: StepParams, dt: f64) -> Config {
     Config {
         family: Family::Party,
         sweep,
         setting,
-        method: Method::Party(Box::new(params)),
+        method: Method::Party(Box::new(params), dt),
     }
 }
 
@@ -307,7 +315,7 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
     let d = StepParams::default;
     let mut c = Vec::new();
     for dt in [0.04, 0.02, 0.01, 0.005, 0.0025] {
-        c.push(party("Δt", format!("{dt} s"), StepParams { dt, ..d() }));
+        c.push(party_at("Δt", format!("{dt} s"), d(), dt));
     }
     for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
         let p = StepParams {
@@ -415,7 +423,6 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
         (0.005, 10),
     ] {
         let p = StepParams {
-            dt,
             shape: atelier_solver::ShapeParams {
                 method: newton,
                 max_iterations: cap,
@@ -423,10 +430,11 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
             },
             ..d()
         };
-        c.push(party(
+        c.push(party_at(
             "Newton shape",
             format!("Δt {dt} s, {cap} per pass"),
             p,
+            dt,
         ));
     }
 
@@ -441,7 +449,7 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
             family: Family::MassSpring,
             sweep: "Δt",
             setting: format!("{dt:.2e} s ({f} × limit est.)"),
-            method: Method::MassSpring(MassSpringParams { dt, ..ms.clone() }),
+            method: Method::MassSpring(ms.clone(), dt),
         });
     }
 
@@ -454,10 +462,13 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
             family: Family::Xpbd,
             sweep: "sweeps (10 substeps)",
             setting: format!("{iterations} sweeps"),
-            method: Method::Xpbd(XpbdParams {
-                iterations,
-                ..xp.clone()
-            }),
+            method: Method::Xpbd(
+                XpbdParams {
+                    iterations,
+                    ..xp.clone()
+                },
+                XPBD_DT,
+            ),
         });
     }
     for substeps in [1, 2, 5, 10, 20, 50, 100] {
@@ -465,11 +476,14 @@ fn configurations(cloth: &Cloth) -> Vec<Config> {
             family: Family::Xpbd,
             sweep: "substeps (1 sweep)",
             setting: format!("{substeps} substeps"),
-            method: Method::Xpbd(XpbdParams {
-                substeps,
-                iterations: 1,
-                ..xp.clone()
-            }),
+            method: Method::Xpbd(
+                XpbdParams {
+                    substeps,
+                    iterations: 1,
+                    ..xp.clone()
+                },
+                XPBD_DT,
+            ),
         });
     }
     c
@@ -485,19 +499,19 @@ fn own_references(cloth: &Cloth) -> [(Family, Method); 2] {
     [
         (
             Family::MassSpring,
-            Method::MassSpring(MassSpringParams {
-                dt: dividing_dt(0.01 * limit),
-                ..ms
-            }),
+            Method::MassSpring(ms, dividing_dt(0.01 * limit)),
         ),
         (
             Family::Xpbd,
-            Method::Xpbd(XpbdParams {
-                substeps: 200,
-                iterations: 10,
-                bending: true,
-                ..XpbdParams::default()
-            }),
+            Method::Xpbd(
+                XpbdParams {
+                    substeps: 200,
+                    iterations: 10,
+                    bending: true,
+                    ..XpbdParams::default()
+                },
+                XPBD_DT,
+            ),
         ),
     ]
 }
@@ -534,7 +548,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     let reference = run(
         &cloth,
         &start,
-        &Method::Party(Box::new(reference_params(REFERENCE_DT))),
+        &Method::Party(Box::new(reference_params()), REFERENCE_DT),
     )?;
     let ref_positions = match &reference.outcome {
         Ok(p) => p.clone(),
@@ -545,7 +559,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     let check = run(
         &cloth,
         &start,
-        &Method::Party(Box::new(reference_params(2.0 * REFERENCE_DT))),
+        &Method::Party(Box::new(reference_params()), 2.0 * REFERENCE_DT),
     )?;
     let uncertainty = match &check.outcome {
         Ok(p) => rms_distance(&cloth, p, &ref_positions),
@@ -568,7 +582,8 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     let mut rows = Vec::new();
     for (k, config) in configs.into_iter().enumerate() {
         let r = run(&cloth, &start, &config.method)?;
-        let is_default = matches!(&config.method, Method::Party(p) if **p == default_params);
+        let is_default = matches!(&config.method,
+            Method::Party(p, dt) if **p == default_params && *dt == StepInput::default().dt);
         let (error, own_error, status) = match &r.outcome {
             Ok(p) => {
                 let e = rms_distance(&cloth, p, &ref_positions);

@@ -171,13 +171,33 @@ impl Default for YamadaParams {
     }
 }
 
+/// The PARTY step on a wet scene: its Δt and its parameters. In a scenario file
+/// `Party(dt: 0.005, step: (shape: (tolerance: 1e-6)))`; both may be left out.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WetPartyParams {
+    /// Δt, s. Range (0, 0.1]; default 0.01 (the thesis's).
+    pub dt: f64,
+    /// The step's parameters ([`StepParams`]; gravity is the scene's, along −z).
+    pub step: StepParams,
+}
+
+impl Default for WetPartyParams {
+    fn default() -> Self {
+        Self {
+            dt: 0.01,
+            step: StepParams::default(),
+        }
+    }
+}
+
 /// Which solver runs the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum WetSolver {
     /// Yamada's mass-spring Verlet model.
     Yamada(YamadaParams),
     /// The PARTY step, with the pressure as its stage.
-    Party(StepParams),
+    Party(WetPartyParams),
 }
 
 impl WetSolver {
@@ -193,7 +213,7 @@ impl WetSolver {
     pub fn with_dt(&self, dt: f64) -> Self {
         match self {
             WetSolver::Yamada(p) => WetSolver::Yamada(YamadaParams { dt, ..*p }),
-            WetSolver::Party(p) => WetSolver::Party(StepParams { dt, ..p.clone() }),
+            WetSolver::Party(p) => WetSolver::Party(WetPartyParams { dt, ..p.clone() }),
         }
     }
 

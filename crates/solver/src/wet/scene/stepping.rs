@@ -9,7 +9,7 @@ use atelier_grid::EdgeKind;
 
 use crate::baselines::{MassSpring, MassSpringParams, spring_stiffnesses};
 use crate::cloth::Cloth;
-use crate::params::StepParams;
+use crate::params::{StepInput, StepParams};
 use crate::state::ClothState;
 use crate::step::{SolveStats, Solver};
 use crate::wet::contact::{PlaneHook, YamadaExtras};
@@ -68,14 +68,16 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
                 });
             }
             MassSpringParams {
-                dt: p.dt,
                 damping: p.damping,
                 ..MassSpringParams::default()
             }
             .validate()?;
         }
-        WetSolver::Party(p) => p.validate()?,
+        WetSolver::Party(p) => p.step.validate()?,
     }
+    // The scene's frame has z up.
+    let input = StepInput::new(dt);
+    input.validate()?;
     let picked: Vec<u32> = scene.picks.iter().map(|p| scene.node_at(p.at)).collect();
     let mut releases: Vec<(f64, u32)> = scene
         .picks
@@ -107,7 +109,6 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
                 &cloth, p.springs,
             ))),
             params: MassSpringParams {
-                dt: p.dt,
                 damping: p.damping,
                 ..MassSpringParams::default()
             },
@@ -118,7 +119,7 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
             s.pressure = stage;
             Engine::Party {
                 solver: s,
-                params: p.clone(),
+                params: p.step.clone(),
                 hook: PlaneHook { contact },
             }
         }
@@ -209,7 +210,7 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
                 params,
                 extras,
             } => solver
-                .step_with_extras(&cloth, &mut state, params, extras.as_mut())
+                .step_with_extras(&cloth, &mut state, params, input, extras.as_mut())
                 .map(|_| ()),
             Engine::Party {
                 solver,
@@ -217,12 +218,14 @@ pub fn run(scene: &WetScene, fabric: &Fabric, solver: &WetSolver) -> Result<WetR
                 hook,
             } => {
                 let start = state.time;
-                solver.step_with(&cloth, &mut state, params, hook).map(|r| {
-                    pressure_wall += r.timings.pressure;
-                    if let Some(s) = stats.as_mut() {
-                        s.add(&r, params, start);
-                    }
-                })
+                solver
+                    .step_with(&cloth, &mut state, params, input, hook)
+                    .map(|r| {
+                        pressure_wall += r.timings.pressure;
+                        if let Some(s) = stats.as_mut() {
+                            s.add(&r, params, start);
+                        }
+                    })
             }
         };
         wall += t0.elapsed();

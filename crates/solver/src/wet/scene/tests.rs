@@ -25,9 +25,9 @@ fn party_runs_count_their_steps_reports() {
         duration: 0.05,
         ..WetScene::default()
     };
-    let params = StepParams {
+    let params = WetPartyParams {
         dt: 0.005,
-        ..StepParams::default()
+        ..WetPartyParams::default()
     };
     let party = run(&scene, &fabric, &WetSolver::Party(params.clone())).expect("runs");
     let stats = party.stats.expect("the PARTY step's stats");
@@ -35,7 +35,10 @@ fn party_runs_count_their_steps_reports() {
     assert_eq!((stats.steps, party.steps), (10, 10));
     assert!(stats.unconverged <= stats.steps && stats.shape_unconverged <= stats.unconverged);
     assert!(stats.worst_violation.is_finite());
-    assert_eq!(stats.tolerance.to_bits(), params.shape.tolerance.to_bits());
+    assert_eq!(
+        stats.tolerance.to_bits(),
+        params.step.shape.tolerance.to_bits()
+    );
     let yamada = WetSolver::Yamada(YamadaParams::default());
     let short = WetScene {
         duration: 0.001,
