@@ -43,13 +43,16 @@ pub struct Row {
     pub unmet: Vec<String>,
     /// Why the run failed or could not start.
     pub failure: Option<String>,
+    /// Whether `cargo test` runs it in full (`fixtures/scenarios/CI.md`).
+    pub in_ci: bool,
     /// The report, when the run produced one.
     #[serde(skip)]
     pub report: Option<Report>,
 }
 
 impl Row {
-    fn passed(&self) -> bool {
+    /// Ran to its end and met every expectation.
+    pub(crate) fn passed(&self) -> bool {
         self.failure.is_none() && self.expectations_met
     }
 }
@@ -87,7 +90,7 @@ pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
 }
 
 /// Every scenario file, sorted by name.
-fn scenario_files(root: &Path) -> Result<Vec<PathBuf>> {
+pub(crate) fn scenario_files(root: &Path) -> Result<Vec<PathBuf>> {
     let dir = root.join("fixtures/scenarios");
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
         .with_context(|| format!("cannot list {}", dir.display()))?
@@ -98,7 +101,7 @@ fn scenario_files(root: &Path) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-fn stem(p: &Path) -> String {
+pub(crate) fn stem(p: &Path) -> String {
     p.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default()
@@ -134,11 +137,13 @@ pub fn run_all(
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     // The commit the results come from, read before this run writes into docs/.
     let revision = commit(root);
+    let in_ci = crate::ci_scenarios::lists(root)?.full;
     let clock = Instant::now();
     let mut rows = Vec::new();
     for (k, file) in selected.iter().enumerate() {
         eprintln!("[{}/{}] {}", k + 1, selected.len(), stem(file));
-        let row = run_one(root, file, out);
+        let mut row = run_one(root, file, out);
+        row.in_ci = in_ci.contains(&stem(file));
         eprintln!("    {}", row_line(&row));
         rows.push(row);
     }
@@ -172,7 +177,8 @@ pub fn run_all(
     Ok(summary.passed == summary.scenarios)
 }
 
-fn run_one(root: &Path, file: &Path, out: &Path) -> Row {
+/// Run one scenario file into `out/NAME/`.
+pub(crate) fn run_one(root: &Path, file: &Path, out: &Path) -> Row {
     let rel = file
         .strip_prefix(root)
         .unwrap_or(file)
@@ -189,6 +195,7 @@ fn run_one(root: &Path, file: &Path, out: &Path) -> Row {
         expectations_met: false,
         unmet: Vec::new(),
         failure: None,
+        in_ci: false,
         report: None,
     };
     let scenario = match Scenario::load(file) {
@@ -382,9 +389,9 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
     }
     let _ = writeln!(
         md,
-        "| scenario | kind | wall s | steps | simulated s | key metrics | expectations | failure |"
+        "| scenario | kind | wall s | steps | simulated s | key metrics | expectations | in CI | failure |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
     for r in &s.rows {
         let expectations = if r.unmet.is_empty() {
             if r.report.as_ref().is_some_and(|x| x.expectations.is_empty()) {
@@ -399,7 +406,7 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
         };
         let _ = writeln!(
             md,
-            "| {} | {} | {:.1} | {} | {:.2} | {} | {} | {} |",
+            "| {} | {} | {:.1} | {} | {:.2} | {} | {} | {} | {} |",
             r.name,
             r.kind,
             r.wall_s,
@@ -407,6 +414,7 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
             r.simulated_s,
             r.key_metrics,
             expectations,
+            if r.in_ci { "in full" } else { "–" },
             r.failure
                 .as_deref()
                 .map_or("–".to_string(), |f| f.replace('|', "\\|"))

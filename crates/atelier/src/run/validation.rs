@@ -481,8 +481,12 @@ fn kes_frames(start: Vec<[f64; 3]>, end: &ClothState, time: f64) -> Animation {
     a
 }
 
-/// The virtual KES-FB1 tensile test: the specimen's loop 0 → F_m → 0 against the fabric's
-/// own loop along the same path (its tensile model, state by state).
+/// The virtual KES-FB1 tensile test: the specimen's loop 0 → F_m → 0, read from the moving
+/// clamp's reaction against its displacement, summarised as EMT, LT, WT and RT and compared
+/// with the fabric's own KES values (its loop's summary as loaded: `kes::input_values`). Until
+/// issue 23 the reference was the fabric's tensile model stepped along the same path and
+/// summarised by the same code as the specimen — the model against itself. The chart still
+/// draws the model's loop beside the specimen's.
 pub(super) fn kes_tensile(spec: &KesTensileSpec, fabric: &Fabric) -> Result<Simulated, RunError> {
     use atelier_fabric::{TensileState, units};
     use atelier_solver::kes;
@@ -502,7 +506,7 @@ pub(super) fn kes_tensile(spec: &KesTensileSpec, fabric: &Fabric) -> Result<Simu
         .iter()
         .map(|&f| (f, st.update(input_loop, f)))
         .collect();
-    let (sim, input) = (curve.kes_values(), kes::values_of(&model));
+    let (sim, input) = (curve.kes_values(), kes::input_values(input_loop));
     let mut metrics = BTreeMap::new();
     let errors = [
         (sim.emt, input.emt),

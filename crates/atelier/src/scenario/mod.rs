@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::scene::GarmentSpec;
 
+pub mod bounds;
 pub mod string_fit;
 pub mod wet;
 
@@ -759,6 +760,25 @@ impl Scenario {
                     &field,
                     ErrorKind::Inconsistent,
                     format!("min {lo} > max {hi}"),
+                );
+            }
+            // `unconverged_fraction` is the exception: without a bound a run fails on any step
+            // that missed its tolerance, so a bound of 1 is a deliberate acceptance of
+            // unconverged steps (docs/report.md, convergence), not a check that cannot fail.
+            if e.metric != crate::convergence::UNCONVERGED_FRACTION
+                && bounds::covers_everything(&e.metric, e.min, e.max)
+            {
+                let (lo, hi) = bounds::physical_range(&e.metric);
+                return bad(
+                    &field,
+                    ErrorKind::Inconsistent,
+                    format!(
+                        "[{}, {}] covers the whole physical range [{lo}, {hi}] of `{}`: no run \
+                         can miss it; bound it by a reference (docs/report.md, expectations)",
+                        e.min.map_or("−∞".to_string(), |v| v.to_string()),
+                        e.max.map_or("∞".to_string(), |v| v.to_string()),
+                        e.metric
+                    ),
                 );
             }
         }

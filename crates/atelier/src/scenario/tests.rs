@@ -66,3 +66,40 @@ fn errors_name_position_and_field() {
         .expect_err("bad name");
     assert_eq!(e.field, "name");
 }
+
+/// An expectation that no run can miss is refused with its field, the metric's physical range
+/// and where the expectation is (issue 23: eight drape scenarios once "expected" a drape
+/// coefficient in [0, 100] or [−1, 101]); a bound inside the range, or a one-sided bound on a
+/// quantity that cannot be negative given from above, is accepted. `unconverged_fraction` may
+/// be bounded by 1: that accepts unconverged steps, which a run otherwise fails on.
+#[test]
+fn an_expectation_that_cannot_fail_is_refused() {
+    let with = |bound: &str| {
+        parse(&format!(
+            "(name: \"d\", reproduces: \"x\", kind: Drape(fabric: \"f.ron\", tester: Jis),\n \
+             expectations: [(metric: \"node_count\", max: 9.0),\n  {bound}])"
+        ))
+    };
+    for bound in [
+        r#"(metric: "drape_coefficient_percent", min: 0.0, max: 100.0)"#,
+        r#"(metric: "drape_coefficient_percent", min: -1.0, max: 101.0)"#,
+        r#"(metric: "drape_coefficient_percent", max: 100.0)"#,
+        r#"(metric: "shadow_area_m2", min: 0.0)"#,
+        r#"(metric: "settled", min: 0.0, max: 1.0)"#,
+    ] {
+        let e = with(bound).expect_err(bound);
+        assert_eq!(e.kind, ErrorKind::Inconsistent, "{bound}: {e}");
+        assert_eq!(e.field, "expectations[1]", "{bound}: {e}");
+        assert_eq!(e.position.map(|p| p.line), Some(3), "{bound}: {e}");
+        assert!(e.to_string().contains("physical range"), "{bound}: {e}");
+    }
+    for bound in [
+        r#"(metric: "drape_coefficient_percent", min: 74.9, max: 90.9)"#,
+        r#"(metric: "drape_coefficient_percent", min: 0.5)"#,
+        r#"(metric: "shadow_area_m2", max: 0.1)"#,
+        r#"(metric: "settled", min: 1.0)"#,
+        r#"(metric: "unconverged_fraction", max: 1.0)"#,
+    ] {
+        with(bound).unwrap_or_else(|e| panic!("{bound}: {e}"));
+    }
+}
