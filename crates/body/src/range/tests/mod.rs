@@ -120,5 +120,6 @@ fn sphere_mesh(centre: V3, radius: f64, nlat: usize, nlon: usize) -> LabelledMes
 }
 
 mod from_images;
+mod known_answers;
 mod round_trip;
 mod shapes;
