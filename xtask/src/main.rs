@@ -37,7 +37,6 @@
 //!   scenario fails or misses an expectation.
 
 mod bench_report;
-mod ci_scenarios;
 mod figures;
 mod knob_table;
 mod layout;

@@ -56,8 +56,8 @@ pub fn lists(root: &Path) -> Result<Lists> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::{run_one, scenario_files, stem};
     use super::*;
-    use crate::run_scenarios::{run_one, scenario_files, stem};
 
     fn root() -> std::path::PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("..")

@@ -20,6 +20,8 @@ use atelier::run::{RunOptions, base_of, run};
 use atelier::scenario::Scenario;
 use serde::Serialize;
 
+pub mod ci;
+
 /// One row of the summary.
 #[derive(Clone, Debug, Serialize)]
 pub struct Row {
@@ -137,7 +139,7 @@ pub fn run_all(
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     // The commit the results come from, read before this run writes into docs/.
     let revision = commit(root);
-    let in_ci = crate::ci_scenarios::lists(root)?.full;
+    let in_ci = ci::lists(root)?.full;
     let clock = Instant::now();
     let mut rows = Vec::new();
     for (k, file) in selected.iter().enumerate() {
