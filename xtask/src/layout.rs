@@ -8,6 +8,11 @@
 //!   cycles reported.
 //! - **No source file over [`MAX_LINES`] lines without a stated reason**: a longer file says why
 //!   in its module doc, on a line beginning `//! Length:`.
+//! - **Every test a table of `docs/validation.md` names exists** (issue 23: five rows named tests
+//!   that had been removed or renamed, so their numbers were asserted by nothing): each
+//!   `` `name` `` or `` `module::name` `` in the last cell of a table row must be a `fn` somewhere
+//!   in `crates/` or `xtask/`. A row that keeps a removed test's numbers as history names it
+//!   without backticks.
 //!
 //! The same checks run as this module's tests, so `cargo test --workspace` (CI) keeps them.
 
@@ -230,9 +235,60 @@ fn long_files(src: &Path) -> Result<Vec<(PathBuf, usize)>> {
     Ok(out)
 }
 
+/// The tests the tables of `docs/validation.md` name (the last cell's backticked names, the last
+/// path segment of each) that are no `fn` of the sources, with the line of the first mention.
+fn unknown_tests(root: &Path) -> Result<Vec<(String, usize)>> {
+    let doc = root.join("docs/validation.md");
+    let text = std::fs::read_to_string(&doc).with_context(|| doc.display().to_string())?;
+    let mut functions = BTreeSet::new();
+    for dir in [root.join("crates"), root.join("xtask")] {
+        for file in rust_files(&dir)? {
+            let code =
+                std::fs::read_to_string(&file).with_context(|| file.display().to_string())?;
+            for rest in code.split("fn ").skip(1) {
+                let name: String = rest
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                functions.insert(name);
+            }
+        }
+    }
+    let mut out: Vec<(String, usize)> = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let Some(row) = line.strip_prefix('|') else {
+            continue;
+        };
+        let last = row
+            .trim_end()
+            .trim_end_matches('|')
+            .rsplit('|')
+            .next()
+            .unwrap_or("");
+        for (k, quoted) in last.split('`').enumerate() {
+            let is_path = !quoted.is_empty()
+                && quoted
+                    .chars()
+                    .all(|c| c.is_alphanumeric() || c == '_' || c == ':');
+            if k % 2 == 1 && is_path {
+                let name = quoted.rsplit("::").next().unwrap_or(quoted).to_string();
+                if !functions.contains(&name) && !out.iter().any(|(m, _)| *m == name) {
+                    out.push((name, n + 1));
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// Every problem found, one line each (empty when the layout keeps its rules).
 pub fn problems(root: &Path) -> Result<Vec<String>> {
     let mut out = Vec::new();
+    for (name, line) in unknown_tests(root)? {
+        out.push(format!(
+            "docs/validation.md:{line}: names the test `{name}`, which is no fn of the sources"
+        ));
+    }
     for (name, src) in source_roots(root)? {
         for cycle in cycles(&module_graph(&src)?) {
             out.push(format!("{name}: import cycle among {}", cycle.join(", ")));
