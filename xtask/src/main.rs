@@ -178,7 +178,7 @@ fn main() -> Result<()> {
                 .transpose()?;
             let root = repository_root();
             let out = out.unwrap_or_else(|| root.join("target/scenarios"));
-            if !run_scenarios::run_all(&root, &only, &skip, &out, shard)? {
+            if !run_scenarios::run_all(&root, &only, &skip, &out, shard)?.all_passed() {
                 eprintln!("some scenarios failed or missed an expectation (see above)");
                 std::process::exit(1);
             }

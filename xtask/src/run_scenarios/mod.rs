@@ -76,6 +76,22 @@ pub struct Summary {
     pub rows: Vec<Row>,
 }
 
+impl Summary {
+    /// Every scenario run ran to its end and met its expectations.
+    pub fn all_passed(&self) -> bool {
+        self.passed == self.scenarios
+    }
+
+    /// The scenarios that did not run to their end (diverged or could not start).
+    pub fn failed(&self) -> Vec<&str> {
+        self.rows
+            .iter()
+            .filter(|r| r.failure.is_some())
+            .map(|r| r.name.as_str())
+            .collect()
+    }
+}
+
 /// Parse `I/N` (1 ≤ I ≤ N).
 pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
     let (i, n) = text
@@ -109,14 +125,14 @@ pub(crate) fn stem(p: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// Run the selection; returns whether all passed.
+/// Run the selection; returns its summary ([`Summary::all_passed`]).
 pub fn run_all(
     root: &Path,
     only: &[String],
     skip: &[String],
     out: &Path,
     shard: Option<(usize, usize)>,
-) -> Result<bool> {
+) -> Result<Summary> {
     let all = scenario_files(root)?;
     for (flag, names) in [("--only", only), ("--skip", skip)] {
         for name in names {
@@ -176,7 +192,7 @@ pub fn run_all(
     } else {
         eprintln!("docs/results.md left as it was (not every scenario ran)");
     }
-    Ok(summary.passed == summary.scenarios)
+    Ok(summary)
 }
 
 /// Run one scenario file into `out/NAME/`.
