@@ -885,16 +885,7 @@ fn an_analytic_sphere_reads_its_radius_change() {
 fn the_gridded_body_moved_outward_by_d_reads_d_more() {
     let body = synthetic::Mannequin::jis_9ar().body(5.0);
     let (mesh, _) = grid_body(&body, &BodyGridParams::default()).expect("the body grids");
-    let lm = LabelledMesh {
-        vertices: mesh
-            .positions
-            .iter()
-            .map(|p| V3::new(p[0], p[1], p[2]))
-            .collect(),
-        triangles: mesh.triangles.clone(),
-        vertex_part: mesh.vertex_part.clone(),
-        triangle_part: mesh.triangle_part.clone(),
-    };
+    let lm = labelled(&mesh);
     let base = measure_error(&mesh, &body);
     for d in [1.0, 5.0, 10.0] {
         let e = measure_error(&body_mesh(&inflated_in_depth(&lm, d)), &body);

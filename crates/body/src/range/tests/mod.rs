@@ -119,6 +119,20 @@ fn sphere_mesh(centre: V3, radius: f64, nlat: usize, nlon: usize) -> LabelledMes
     m
 }
 
+/// The gridded body as a labelled mesh.
+fn labelled(mesh: &BodyMesh) -> LabelledMesh {
+    LabelledMesh {
+        vertices: mesh
+            .positions
+            .iter()
+            .map(|p| V3::new(p[0], p[1], p[2]))
+            .collect(),
+        triangles: mesh.triangles.clone(),
+        vertex_part: mesh.vertex_part.clone(),
+        triangle_part: mesh.triangle_part.clone(),
+    }
+}
+
 mod from_images;
 mod known_answers;
 mod round_trip;

@@ -3,20 +3,6 @@
 
 use super::*;
 
-/// The gridded body as a labelled mesh.
-fn labelled(mesh: &BodyMesh) -> LabelledMesh {
-    LabelledMesh {
-        vertices: mesh
-            .positions
-            .iter()
-            .map(|p| V3::new(p[0], p[1], p[2]))
-            .collect(),
-        triangles: mesh.triangles.clone(),
-        vertex_part: mesh.vertex_part.clone(),
-        triangle_part: mesh.triangle_part.clone(),
-    }
-}
-
 /// A mannequin made of the gridded body's parts (each part's triangles; pivots from the rings;
 /// the pelvis pivots at its centroid). The parts are open at the cuts but their union is closed.
 fn mannequin_from(mesh: &BodyMesh) -> Mannequin {
