@@ -8,11 +8,12 @@
 //!   cycles reported.
 //! - **No source file over [`MAX_LINES`] lines without a stated reason**: a longer file says why
 //!   in its module doc, on a line beginning `//! Length:`.
-//! - **Every test a table of `docs/validation.md` names exists** (issue 23: five rows named tests
-//!   that had been removed or renamed, so their numbers were asserted by nothing): each
-//!   `` `name` `` or `` `module::name` `` in the last cell of a table row must be a `fn` somewhere
-//!   in `crates/` or `xtask/`. A row that keeps a removed test's numbers as history names it
-//!   without backticks.
+//! - **Every test a table of `docs/validation.md` or `docs/claims.md` names exists** (issue 23:
+//!   five rows named tests that had been removed or renamed, so their numbers were asserted by
+//!   nothing): each `` `name` `` or `` `module::name` `` in the test cell of a table row (the
+//!   last cell in validation.md, the third in claims.md) must be a `fn` somewhere in `crates/`
+//!   or `xtask/`. A row that keeps a removed test's numbers as history names it without
+//!   backticks.
 //!
 //! The same checks run as this module's tests, so `cargo test --workspace` (CI) keeps them.
 
@@ -235,11 +236,14 @@ fn long_files(src: &Path) -> Result<Vec<(PathBuf, usize)>> {
     Ok(out)
 }
 
-/// The tests the tables of `docs/validation.md` name (the last cell's backticked names, the last
-/// path segment of each) that are no `fn` of the sources, with the line of the first mention.
-fn unknown_tests(root: &Path) -> Result<Vec<(String, usize)>> {
-    let doc = root.join("docs/validation.md");
-    let text = std::fs::read_to_string(&doc).with_context(|| doc.display().to_string())?;
+/// The documents whose tables name tests, with the cell that names them (`None`: the last).
+const TEST_TABLES: [(&str, Option<usize>); 2] =
+    [("docs/validation.md", None), ("docs/claims.md", Some(2))];
+
+/// The tests the tables of [`TEST_TABLES`] name (the test cell's backticked names, the last path
+/// segment of each) that are no `fn` of the sources, with the document and the line of the first
+/// mention.
+fn unknown_tests(root: &Path) -> Result<Vec<(String, String, usize)>> {
     let mut functions = BTreeSet::new();
     for dir in [root.join("crates"), root.join("xtask")] {
         for file in rust_files(&dir)? {
@@ -254,26 +258,29 @@ fn unknown_tests(root: &Path) -> Result<Vec<(String, usize)>> {
             }
         }
     }
-    let mut out: Vec<(String, usize)> = Vec::new();
-    for (n, line) in text.lines().enumerate() {
-        let Some(row) = line.strip_prefix('|') else {
-            continue;
-        };
-        let last = row
-            .trim_end()
-            .trim_end_matches('|')
-            .rsplit('|')
-            .next()
-            .unwrap_or("");
-        for (k, quoted) in last.split('`').enumerate() {
-            let is_path = !quoted.is_empty()
-                && quoted
-                    .chars()
-                    .all(|c| c.is_alphanumeric() || c == '_' || c == ':');
-            if k % 2 == 1 && is_path {
-                let name = quoted.rsplit("::").next().unwrap_or(quoted).to_string();
-                if !functions.contains(&name) && !out.iter().any(|(m, _)| *m == name) {
-                    out.push((name, n + 1));
+    let mut out: Vec<(String, String, usize)> = Vec::new();
+    for (doc, column) in TEST_TABLES {
+        let path = root.join(doc);
+        let text = std::fs::read_to_string(&path).with_context(|| path.display().to_string())?;
+        for (n, line) in text.lines().enumerate() {
+            let Some(row) = line.strip_prefix('|') else {
+                continue;
+            };
+            let cells: Vec<&str> = row.trim_end().trim_end_matches('|').split('|').collect();
+            let cell = match column {
+                None => cells.last(),
+                Some(k) => cells.get(k),
+            };
+            for (k, quoted) in cell.copied().unwrap_or("").split('`').enumerate() {
+                let is_path = !quoted.is_empty()
+                    && quoted
+                        .chars()
+                        .all(|c| c.is_alphanumeric() || c == '_' || c == ':');
+                if k % 2 == 1 && is_path {
+                    let name = quoted.rsplit("::").next().unwrap_or(quoted).to_string();
+                    if !functions.contains(&name) && !out.iter().any(|(m, ..)| *m == name) {
+                        out.push((name, doc.to_string(), n + 1));
+                    }
                 }
             }
         }
@@ -284,9 +291,9 @@ fn unknown_tests(root: &Path) -> Result<Vec<(String, usize)>> {
 /// Every problem found, one line each (empty when the layout keeps its rules).
 pub fn problems(root: &Path) -> Result<Vec<String>> {
     let mut out = Vec::new();
-    for (name, line) in unknown_tests(root)? {
+    for (name, doc, line) in unknown_tests(root)? {
         out.push(format!(
-            "docs/validation.md:{line}: names the test `{name}`, which is no fn of the sources"
+            "{doc}:{line}: names the test `{name}`, which is no fn of the sources"
         ));
     }
     for (name, src) in source_roots(root)? {
