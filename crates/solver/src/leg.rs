@@ -94,6 +94,8 @@ pub struct LegRun {
     pub contacts: usize,
     /// Node transfers of the leg's motion, over all steps.
     pub transfers: usize,
+    /// Steps that missed their tolerance (`StepReport::converged` false).
+    pub unconverged: usize,
 }
 
 fn rotate_x(p: &V3, theta: f64) -> V3 {
@@ -151,6 +153,7 @@ pub fn run_leg(scene: &LegScene, fabric: &Fabric) -> Result<LegRun, LegError> {
         collision: Duration::ZERO,
         contacts: 0,
         transfers: 0,
+        unconverged: 0,
     };
     let (mut start, mut end) = (leg.clone(), leg.clone());
     for k in 0..steps {
@@ -165,6 +168,7 @@ pub fn run_leg(scene: &LegScene, fabric: &Fabric) -> Result<LegRun, LegError> {
         let report = solver.step_with(&cloth, &mut state, &params, input, &mut contact)?;
         run.wall += t0.elapsed();
         run.collision += report.timings.collision + report.timings.transfer;
+        run.unconverged += usize::from(!report.converged);
         let stats = contact.take_stats();
         run.contacts += stats.body_hits + stats.planes;
         run.transfers += stats.transferred;

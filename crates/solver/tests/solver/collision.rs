@@ -53,6 +53,10 @@ fn the_physical_model_alone_also_keeps_the_nodes_out_at_the_thesis_step() {
             "{narrow:?}: the leg must reach the tube: {r:?}"
         );
         assert_eq!(r.frames_with_penetration, 0, "{narrow:?}: {r:?}");
+        assert_eq!(
+            r.unconverged, 0,
+            "{narrow:?}: steps above the tolerance: {r:?}"
+        );
     }
     let physical = ContactParams {
         staged: false,
@@ -108,7 +112,7 @@ fn walking_skirt(
     contact_params: ContactParams,
     dt: f64,
     duration: f64,
-) -> Result<(usize, usize, f64, usize), String> {
+) -> Result<(usize, usize, f64, usize, usize), String> {
     use atelier_body::{Body, Motion, MotionSpec};
     use atelier_collide::V3;
     use atelier_collide::distance::BodyDistance;
@@ -170,15 +174,17 @@ fn walking_skirt(
     let mut solver = Solver::new();
     let steps = (duration / dt).round() as usize;
     let (mut frames, mut worst, mut deepest, mut contacts) = (0, 0, 0.0f64, 0);
+    let mut unconverged = 0;
     for k in 0..steps {
         let t = k as f64 * dt;
         let (a, b) = (body.at(&motion, t), body.at(&motion, t + dt));
         contact
             .set_body(&a.positions, &b.positions, &tris, dt)
             .expect("body");
-        solver
+        let report = solver
             .step_with(&cloth, &mut state, &params, input, &mut contact)
             .map_err(|e| format!("step {k}: {e}"))?;
+        unconverged += usize::from(!report.converged);
         let stats = contact.take_stats();
         contacts += stats.body_hits + stats.planes;
         let mut inside = vec![false; state.positions.len()];
@@ -198,7 +204,7 @@ fn walking_skirt(
             worst = worst.max(n);
         }
     }
-    Ok((frames, worst, deepest, contacts))
+    Ok((frames, worst, deepest, contacts, unconverged))
 }
 
 #[test]
@@ -207,9 +213,11 @@ fn the_staged_model_keeps_a_skirt_out_of_the_walking_mannequin() {
 }
 
 /// The walking skirt at Δt 0.01 s for 3 s with `params`: the legs reach it (more than 100
-/// contacts) and no frame has a node more than 2 mm inside the body.
+/// contacts), every step meets its tolerance, and no frame has a node more than 2 mm inside the
+/// body.
 fn assert_the_skirt_stays_out(label: &str, params: ContactParams) {
-    let (frames, worst, deepest, contacts) = walking_skirt(params, 0.01, 3.0).expect("runs");
+    let (frames, worst, deepest, contacts, unconverged) =
+        walking_skirt(params, 0.01, 3.0).expect("runs");
     eprintln!(
         "{label}, dt 0.01: {frames} frames with nodes inside (up to {worst}, {:.1} mm), {contacts} contacts",
         deepest * 1e3
@@ -224,6 +232,7 @@ fn assert_the_skirt_stays_out(label: &str, params: ContactParams) {
         "up to {worst} nodes inside, {:.1} mm deep",
         deepest * 1e3
     );
+    assert_eq!(unconverged, 0, "{label}: steps above the tolerance");
 }
 
 #[test]
@@ -294,7 +303,7 @@ fn skirt_measurements() {
     for (name, params, dt) in cases {
         let t0 = std::time::Instant::now();
         match walking_skirt(params, dt, 3.0) {
-            Ok((frames, worst, deepest, contacts)) => eprintln!(
+            Ok((frames, worst, deepest, contacts, _)) => eprintln!(
                 "| {name} | {dt} | {frames} of {} | {worst} | {:.1} | {contacts} | {:.1} |",
                 (3.0 / dt).round(),
                 deepest * 1e3,
