@@ -53,9 +53,10 @@ pub struct Row {
 }
 
 impl Row {
-    /// Ran to its end and met every expectation.
+    /// Ran to its end and passed as `atelier run` judges it (`Report::passed`: every
+    /// expectation met, every step converged unless the scenario bounds `unconverged_fraction`).
     pub(crate) fn passed(&self) -> bool {
-        self.failure.is_none() && self.expectations_met
+        self.failure.is_none() && self.report.as_ref().is_some_and(Report::passed)
     }
 }
 
@@ -64,7 +65,7 @@ impl Row {
 pub struct Summary {
     /// Scenarios run.
     pub scenarios: usize,
-    /// Scenarios that ran to their end and met their expectations.
+    /// Scenarios that passed ([`Row::passed`]: to their end, expectations met, steps converged).
     pub passed: usize,
     /// Shard run, `I/N`, if any.
     pub shard: Option<String>,
@@ -371,6 +372,8 @@ fn row_line(r: &Row) -> String {
         format!("FAILED: {f}")
     } else if !r.expectations_met {
         format!("EXPECTATION NOT MET: {}", r.unmet.join("; "))
+    } else if !r.passed() {
+        "NOT PASSED (unconverged steps or a doubtful try-on: see its report)".into()
     } else {
         "ok".into()
     };
@@ -386,7 +389,8 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "{} of {} scenarios ran to their end and met their expectations{}; {:.0} s wall in all.\n",
+        "{} of {} scenarios passed (ran to their end, met their expectations, every step \
+         converged){}; {:.0} s wall in all.\n",
         s.passed,
         s.scenarios,
         s.shard
@@ -414,6 +418,9 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
         let expectations = if r.unmet.is_empty() {
             if r.report.as_ref().is_some_and(|x| x.expectations.is_empty()) {
                 "none".to_string()
+            } else if r.report.is_some() && !r.passed() {
+                "met, **not passed**: steps above the tolerance (its report's convergence)"
+                    .to_string()
             } else if r.report.is_some() {
                 "met".to_string()
             } else {
