@@ -309,12 +309,17 @@ impl Case {
     }
 
     /// `Err` if the node, moving on `p + vel·t`, ends the step on the other side of the
-    /// triangle (vertices on `x_k + tri_vel_k·t`) than it started, more than `SIDE_TOL` behind
-    /// its end-of-step plane, having last passed its plane through the closed triangle
-    /// (weights ≥ −`WEIGHT_TOL`, found by [`moving_crossings`]).
-    fn no_end_through(&self, vel: &V3, tri_vel: &[V3; 3]) -> Result<(), String> {
+    /// triangle (vertices on `x_k + tri_vel_k·t`) than `sides` says it belongs, more than
+    /// `SIDE_TOL` behind its end-of-step plane, having last passed its plane through the closed
+    /// triangle (weights ≥ −`WEIGHT_TOL`, found by [`moving_crossings`]). A body triangle
+    /// (`Sides::Front`) keeps nodes in front of its counter-clockwise normal; a cloth triangle
+    /// (`Sides::Both`) on the side they started on.
+    fn no_end_through(&self, vel: &V3, tri_vel: &[V3; 3], sides: Sides) -> Result<(), String> {
         let end = [0, 1, 2].map(|k| self.x[k] + tri_vel[k] * DT);
-        let side = area_normal(&self.x).dot(&(self.p - self.x[0])).signum();
+        let side = match sides {
+            Sides::Front => 1.0,
+            Sides::Both => area_normal(&self.x).dot(&(self.p - self.x[0])).signum(),
+        };
         let q = self.p + vel * DT;
         let depth = -(q - end[0]).dot(&area_normal(&end).normalize()) * side;
         if depth <= SIDE_TOL {
@@ -664,11 +669,18 @@ proptest! {
 
     /// A node aimed through a body triangle that turns and deforms during the step (well
     /// shaped, 0.2–0.5 m; vertex velocities a common part up to 4 m/s plus up to 1 m/s each),
-    /// otherwise as in the translating test, must not end the step on the other side of the
-    /// triangle, more than 1e-12 m behind its end-of-step plane, having last passed its plane
-    /// through the closed triangle (weights ≥ −5e-10): the node moving on p + v′t, the
-    /// vertices on x_k + u_k t, the crossings found by the independent root search. 2048 cases
-    /// (`CASES_IGNORED`).
+    /// otherwise as in the translating test, must not end the step behind the triangle (on the
+    /// side away from its counter-clockwise normal: a body keeps nodes outside), more than
+    /// 1e-12 m behind its end-of-step plane, having last passed its plane through the closed
+    /// triangle (weights ≥ −5e-10): the node moving on p + v′t, the vertices on x_k + u_k t,
+    /// the crossings found by the independent root search. 2048 cases (`CASES_IGNORED`).
+    ///
+    /// "Behind" is the body's inside, not the side the node started on: a turning triangle
+    /// can sweep past a node in the first instants of the step, so the generator (which places
+    /// the start at `target(λΔt) − vλΔt`) now and then starts a node a few tens of nm behind
+    /// the start plane, which the triangle then passes; such a node, caught later from the
+    /// front, ends in front, as it should, and was counted as passing through when the side
+    /// was taken from the start (about 1 case in 10⁴).
     ///
     /// FAILS. Over 200 000 cases: 0.54 % of those with ν > 0 end through (depth behind the
     /// plane median 0.11 mm, max 6.9 mm; half deeper than the 0.1 mm skin) and 36 % of those
@@ -693,7 +705,7 @@ proptest! {
         prop_assert!(guard.is_ok(), "{}", guard.unwrap_err());
         for broad in BROADS {
             let v = case.resolve_body(params(nu, rho, broad));
-            let r = case.no_end_through(&v, &u);
+            let r = case.no_end_through(&v, &u, Sides::Front);
             prop_assert!(r.is_ok(), "{broad:?} ν {nu} ρ {rho}: {}", r.unwrap_err());
         }
     }
@@ -732,7 +744,7 @@ proptest! {
         prop_assert!(guard.is_ok(), "{}", guard.unwrap_err());
         for broad in BROADS {
             let vel = case.resolve_cloth(params(nu, rho, broad), masses.map(|m| 1.0 / m));
-            let r = case.no_end_through(&vel[3], &[vel[0], vel[1], vel[2]]);
+            let r = case.no_end_through(&vel[3], &[vel[0], vel[1], vel[2]], Sides::Both);
             prop_assert!(r.is_ok(), "{broad:?} ν {nu} ρ {rho} masses {masses:?}: {}", r.unwrap_err());
         }
     }
@@ -791,13 +803,13 @@ fn unresolved_cases_tunnel_and_the_checks_say_so() {
     let case = Case::aimed(x, uf, [0.2, 0.3, 0.5], aim, false);
     case.guard_moving().expect("guard");
     let raw = [uf[0], uf[1], uf[2], case.v];
-    assert!(case.no_end_through(&case.v, &uf).is_err());
+    assert!(case.no_end_through(&case.v, &uf, Sides::Both).is_err());
     let sep = contact_point_separation(&case, &raw).expect("contact");
     assert!(sep < -0.05, "unresolved separation {sep}");
     let vel = case.resolve_cloth(p(0.1), [500.0, 400.0, 300.0, 600.0]);
     let sep = contact_point_separation(&case, &vel).expect("contact");
     assert!(sep >= -SIDE_TOL, "resolved separation {sep}");
-    case.no_end_through(&vel[3], &[vel[0], vel[1], vel[2]])
+    case.no_end_through(&vel[3], &[vel[0], vel[1], vel[2]], Sides::Both)
         .expect("resolved");
 }
 
@@ -825,7 +837,7 @@ fn a_turning_body_triangle_overtakes_the_node_it_caught() {
     case.guard_moving().expect("guard");
     for broad in BROADS {
         let v = case.resolve_body(params(0.0, 0.0, broad));
-        if let Err(e) = case.no_end_through(&v, &u) {
+        if let Err(e) = case.no_end_through(&v, &u, Sides::Front) {
             panic!("{broad:?}: {e}");
         }
     }
@@ -855,7 +867,7 @@ fn a_kicked_cloth_triangle_turns_into_the_node_that_kicked_it() {
         let vel = case.resolve_cloth(params(0.0, 0.0, broad), [1000.0; 4]);
         let sep = contact_point_separation(&case, &vel).expect("contact");
         assert!(sep >= -SIDE_TOL, "{broad:?}: separation {sep}");
-        if let Err(e) = case.no_end_through(&vel[3], &[vel[0], vel[1], vel[2]]) {
+        if let Err(e) = case.no_end_through(&vel[3], &[vel[0], vel[1], vel[2]], Sides::Both) {
             panic!("{broad:?}: {e}");
         }
     }
