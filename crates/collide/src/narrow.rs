@@ -139,22 +139,13 @@ pub fn point_triangle(
             }
         }
     }
-    if sides == Sides::Front && s0 < -thickness {
+    // Behind a body triangle's plane at the start: a translating triangle cannot be met from
+    // the front in this step (the distance is linear in time). One that turns can sweep past a
+    // node beside it and be met from the front later in the step.
+    if sides == Sides::Front && s0 < -thickness && u[1] == u[0] && u[2] == u[0] {
         return None;
     }
-    // Coplanarity cubic in t: f(t) = ((x1−x0) × (x2−x0)) · (p − x0), all moving linearly.
-    let (a, b) = (x[1] - x[0], x[2] - x[0]);
-    let (da, db) = (u[1] - u[0], u[2] - u[0]);
-    let (c, dc) = (p - x[0], v - u[0]);
-    // (a + t da) × (b + t db) = a×b + t (a×db + da×b) + t² da×db
-    let (k0, k1, k2) = (a.cross(&b), a.cross(&db) + da.cross(&b), da.cross(&db));
-    let coeffs = [
-        k0.dot(&c),
-        k0.dot(&dc) + k1.dot(&c),
-        k1.dot(&dc) + k2.dot(&c),
-        k2.dot(&dc),
-    ];
-    for t in cubic_roots_in(coeffs, dt) {
+    for t in cubic_roots_in(coplanarity(p, v, x, u), dt) {
         let xt = [0, 1, 2].map(|k| x[k] + u[k] * t);
         let pt = p + v * t;
         let w = barycentric(&pt, [&xt[0], &xt[1], &xt[2]]);
@@ -186,6 +177,67 @@ pub fn point_triangle(
     None
 }
 
+/// The last passage of the point `p` (velocity `v`) through the triangle `x` (vertex velocities
+/// `u`) during `[0, dt]` from its side `side·n` (`side` ±1, `n` the counter-clockwise normal) to
+/// the other, if the point ends the step more than `depth_tol` behind the triangle's end plane
+/// and that last plane crossing was through the closed triangle. The hit's normal points to
+/// the side the point came from.
+///
+/// A triangle that only translates cannot meet a point twice in a step (their normal distance
+/// is linear in time), so after a contact the point's corrected path cannot pass through it. A
+/// triangle that turns or deforms can: a node caught by a swinging body part slides on and is
+/// overtaken, or a cloth triangle turned by the impulse of the contact swings into the node.
+/// The collider asks this of every triangle a node has met in the pass, with the node's
+/// corrected motion, and takes the contact again where it is found.
+pub fn last_pass_through(
+    p: &V3,
+    v: &V3,
+    x: [&V3; 3],
+    u: [&V3; 3],
+    dt: f64,
+    side: f64,
+    depth_tol: f64,
+) -> Option<Hit> {
+    let end = [0, 1, 2].map(|k| x[k] + u[k] * dt);
+    let n_end = unit_normal([&end[0], &end[1], &end[2]])?;
+    let depth = -(p + v * dt - end[0]).dot(&n_end) * side;
+    if depth.is_nan() || depth <= depth_tol {
+        return None;
+    }
+    let t = *cubic_roots_in(coplanarity(p, v, x, u), dt).last()?;
+    let xt = [0, 1, 2].map(|k| x[k] + u[k] * t);
+    let w = barycentric(&(p + v * t), [&xt[0], &xt[1], &xt[2]]);
+    if !inside(&w) {
+        return None;
+    }
+    let nt = unit_normal([&xt[0], &xt[1], &xt[2]])? * side;
+    let ut = u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
+    // Front to back at the last crossing (a root where the point only touches the plane and
+    // stays behind is not a passage).
+    ((v - ut).dot(&nt) < 0.0).then_some(Hit {
+        time: t,
+        weights: w,
+        normal: nt,
+    })
+}
+
+/// The coefficients (constant first) of the coplanarity cubic
+/// `f(t) = ((x₁−x₀) × (x₂−x₀)) · (p − x₀)` of a point and a triangle all moving linearly:
+/// the signed distance of the point from the triangle's plane times twice its area.
+fn coplanarity(p: &V3, v: &V3, x: [&V3; 3], u: [&V3; 3]) -> [f64; 4] {
+    let (a, b) = (x[1] - x[0], x[2] - x[0]);
+    let (da, db) = (u[1] - u[0], u[2] - u[0]);
+    let (c, dc) = (p - x[0], v - u[0]);
+    // (a + t da) × (b + t db) = a×b + t (a×db + da×b) + t² da×db
+    let (k0, k1, k2) = (a.cross(&b), a.cross(&db) + da.cross(&b), da.cross(&db));
+    [
+        k0.dot(&c),
+        k0.dot(&dc) + k1.dot(&c),
+        k1.dot(&dc) + k2.dot(&c),
+        k2.dot(&dc),
+    ]
+}
+
 fn inside(w: &[f64; 3]) -> bool {
     w.iter().all(|&c| c >= -INSIDE)
 }
@@ -209,7 +261,12 @@ pub fn barycentric(p: &V3, x: [&V3; 3]) -> [f64; 3] {
 /// end at zero) is bisected to full precision, so no root is skipped for lack of a good start.
 pub fn cubic_roots_in(c: [f64; 4], t_max: f64) -> ArrayVec<f64, 4> {
     let f = |t: f64| ((c[3] * t + c[2]) * t + c[1]) * t + c[0];
-    let scale = c.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    // The size of f's terms over [0, T]: |c_k|·T^k. (Not max |c_k|: with T = Δt = 0.01 s the
+    // cubic term of a turning triangle weighs 1e-6 of its coefficient, and a tolerance scaled by
+    // the coefficient took an end 7e-12 m behind a triangle for a root at T.)
+    let scale = (0..4)
+        .map(|k| c[k].abs() * t_max.powi(k as i32))
+        .fold(0.0, f64::max);
     if scale == 0.0 || !scale.is_finite() {
         return ArrayVec::new();
     }
@@ -403,5 +460,110 @@ mod tests {
         // Vertex 2 rises at 50 m/s: z(t) = 50·y·t, the plane reaches z = 0.2 at y = 0.8 when
         // t = 0.2/(50·0.8) = 0.005.
         assert_relative_eq!(hit.time, 0.005, epsilon = 1e-12);
+    }
+
+    /// The tilting triangle of `a_tilting_triangle_sweeps_a_resting_point`, tilting down
+    /// (z = −50·y·t), and a point starting 5 mm behind its plane beside it. With
+    /// p(t) = (−0.02 + 10t, 0.5 − 20t, −0.005 − 19t) its height above the plane is
+    /// d(t) = −0.005 + 6t − 1000t² = −1000(t − 1 ms)(t − 5 ms): the plane sweeps past it at 1 ms
+    /// (x = −0.01: beside the triangle), and it passes back through the face at 5 ms
+    /// (x = 0.03, y = 0.4), front to back, ending 45 mm behind.
+    fn behind_then_through() -> ([V3; 3], [V3; 3], V3, V3) {
+        let x = tri();
+        let u = x.map(|q| V3::new(0.0, 0.0, -50.0 * q.y));
+        (
+            x,
+            u,
+            V3::new(-0.02, 0.5, -0.005),
+            V3::new(10.0, -20.0, -19.0),
+        )
+    }
+
+    #[test]
+    fn a_turning_body_triangle_is_met_by_a_point_that_started_behind_its_plane() {
+        let (x, u, p, v) = behind_then_through();
+        let hit = point_triangle(
+            &p,
+            &v,
+            [&x[0], &x[1], &x[2]],
+            [&u[0], &u[1], &u[2]],
+            0.01,
+            0.0,
+            Sides::Front,
+        )
+        .expect("met from the front at 5 ms");
+        assert_relative_eq!(hit.time, 0.005, epsilon = 1e-12);
+        assert!(hit.normal.z > 0.0, "{hit:?}");
+        // The triangle translating instead (every vertex at −25 m/s, its speed under the
+        // point's start): d(t) = −0.005 + 6t, out in front at 0.83 ms and in front to the end,
+        // so never met from the front (the early return for a translating triangle).
+        let ut = [V3::new(0.0, 0.0, -25.0); 3];
+        assert!(
+            point_triangle(
+                &p,
+                &v,
+                [&x[0], &x[1], &x[2]],
+                [&ut[0], &ut[1], &ut[2]],
+                0.01,
+                0.0,
+                Sides::Front
+            )
+            .is_none()
+        );
+    }
+
+    #[test]
+    fn the_last_passage_through_a_triangle_is_found_and_only_if_the_point_ends_behind() {
+        let x = tri();
+        let z = V3::zeros();
+        let zs = [&z, &z, &z];
+        let xs = [&x[0], &x[1], &x[2]];
+        // Straight through a resting triangle: z(t) = 0.1 − 20t, through at 5 ms at (0.2, 0.2),
+        // ends 0.1 m behind.
+        let p = V3::new(0.2, 0.2, 0.1);
+        let v = V3::new(0.0, 0.0, -20.0);
+        let hit = last_pass_through(&p, &v, xs, zs, 0.01, 1.0, 1e-12).expect("through");
+        assert_relative_eq!(hit.time, 0.005, epsilon = 1e-15);
+        assert_relative_eq!(hit.normal.z, 1.0);
+        for (w, e) in hit.weights.iter().zip([0.6, 0.2, 0.2]) {
+            assert_relative_eq!(*w, e, epsilon = 1e-12);
+        }
+        // Seen from the back it ends in front: nothing.
+        assert!(last_pass_through(&p, &v, xs, zs, 0.01, -1.0, 1e-12).is_none());
+        // Ending on the plane, or less than the tolerance behind it: nothing.
+        let on = V3::new(0.0, 0.0, -10.0);
+        assert!(last_pass_through(&p, &on, xs, zs, 0.01, 1.0, 1e-12).is_none());
+        let near = V3::new(0.0, 0.0, -10.0 - 0.5e-12 / 0.01);
+        assert!(last_pass_through(&p, &near, xs, zs, 0.01, 1.0, 1e-12).is_none());
+        // Beside the triangle: ends behind its plane without passing through it.
+        let beside = V3::new(0.8, 0.8, 0.1);
+        assert!(last_pass_through(&beside, &v, xs, zs, 0.01, 1.0, 1e-12).is_none());
+        // Two plane crossings of a tilting triangle: the last, through the face, at 5 ms.
+        let (x, u, p, v) = behind_then_through();
+        let hit = last_pass_through(
+            &p,
+            &v,
+            [&x[0], &x[1], &x[2]],
+            [&u[0], &u[1], &u[2]],
+            0.01,
+            1.0,
+            1e-12,
+        )
+        .expect("through at 5 ms");
+        assert_relative_eq!(hit.time, 0.005, epsilon = 1e-12);
+        // The same path shifted 0.1 m in −x crosses the plane last beside the face (x = −0.05).
+        let p_beside = p - V3::new(0.1, 0.0, 0.0);
+        assert!(
+            last_pass_through(
+                &p_beside,
+                &v,
+                [&x[0], &x[1], &x[2]],
+                [&u[0], &u[1], &u[2]],
+                0.01,
+                1.0,
+                1e-12
+            )
+            .is_none()
+        );
     }
 }

@@ -24,15 +24,22 @@
 //!   vertex counts as tunnelling, rounding cannot make one, and nothing is flagged that the
 //!   collider does not claim to catch.
 //!
-//! Two properties fail (found here; the tests are in place, marked `#[ignore]`): a triangle that
-//! turns or deforms during the step — a body triangle whose vertices move differently, or a
-//! free cloth triangle, which the contact's own impulse turns — can meet the node a second time
-//! after the contact, later in the same step, and `Collider::node_pass` never tests a node
-//! against a triangle it has already met in the pass (`met`). The crate's narrow phase does find
-//! that second meeting on the resolved motion (in 4797 of 4798 failing body cases and all 720
-//! failing cloth cases of a 50 000-case run); it is simply not looked for. A triangle that only
-//! translates cannot meet the node twice (the relative normal distance is linear in time), and
-//! those properties hold exactly.
+//! Two properties failed when these tests were written (session 14; they were `#[ignore]`d with
+//! their numbers): a triangle that turns or deforms during the step — a body triangle whose
+//! vertices move differently, or a free cloth triangle, which the contact's own impulse turns —
+//! can meet the node a second time after the contact, later in the same step, and
+//! `Collider::node_pass` never tested a node again against a triangle it had met in the pass.
+//! A triangle that only translates cannot meet the node twice (the relative normal distance is
+//! linear in time), and those properties held exactly. Since session 15 the collider asks, of
+//! every triangle a node has met, whether the node's corrected path ends the step behind it
+//! having last passed through it (`narrow::last_pass_through`); if so the contact is taken again
+//! at that passage (up to twice), and if the node still ends behind, its end and the triangle's
+//! are moved apart along the triangle's end normal by their inverse masses. Fixing it found two
+//! more misses, in the narrow phase: a node behind a body triangle's plane at the start was
+//! never tested against it, though a turning triangle can sweep past it and be met from the
+//! front; and the root finder's tolerance, scaled by the cubic's largest coefficient instead of
+//! its largest term over the step, took an end 7e-12 m behind the plane for a root at Δt. All
+//! four tests now run and hold (also at 50 000 cases per property, twice).
 
 use std::f64::consts::TAU;
 
@@ -46,9 +53,10 @@ use proptest::test_runner::Config;
 const DT: f64 = 0.01;
 /// Cases per property test.
 const CASES: u32 = 256;
-/// Cases of the two ignored property tests: the cloth one fails in ≈1.4 % of its cases, so at
-/// 256 cases a run with the bug present would still pass 3 % of the time; at 2048, 3e-13.
-const CASES_IGNORED: u32 = 2048;
+/// Cases of the two property tests of turning triangles: the cloth one failed in ≈1.4 % of its
+/// cases before the fix, so at 256 cases a run with the bug present would still pass 3 % of the
+/// time; at 2048, 3e-13.
+const CASES_MOVING: u32 = 2048;
 /// Smallest barycentric weight of an interior target.
 const MARGIN: f64 = 1e-3;
 /// Plane tolerance, m (module docs).
@@ -636,7 +644,7 @@ proptest! {
     /// hit, along the contact normal — `(p′ − Σ w_k x′_k)·n ≥ 0`, which is
     /// `νa(Δt − t_c) + (1 + ν)a·m_red·Σ w_k²/m_k·t_c` (a the approach speed, t_c the contact
     /// time) — asserted to −1e-12 m. It does not guarantee that the node stays off the whole
-    /// triangle: see the ignored `a_cloth_node_aimed_through_a_free_cloth_triangle_never_passes`.
+    /// triangle: `a_cloth_node_aimed_through_a_free_cloth_triangle_never_passes` does.
     /// The contact (t_c, weights, normal) is recomputed with the crate's `point_triangle`, which
     /// must find one. Guard: the unresolved motion passes through the interior (weights ≥ 5e-4),
     /// found by the independent root search.
@@ -665,7 +673,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(config(CASES_IGNORED))]
+    #![proptest_config(config(CASES_MOVING))]
 
     /// A node aimed through a body triangle that turns and deforms during the step (well
     /// shaped, 0.2–0.5 m; vertex velocities a common part up to 4 m/s plus up to 1 m/s each),
@@ -673,7 +681,7 @@ proptest! {
     /// side away from its counter-clockwise normal: a body keeps nodes outside), more than
     /// 1e-12 m behind its end-of-step plane, having last passed its plane through the closed
     /// triangle (weights ≥ −5e-10): the node moving on p + v′t, the vertices on x_k + u_k t,
-    /// the crossings found by the independent root search. 2048 cases (`CASES_IGNORED`).
+    /// the crossings found by the independent root search. 2048 cases (`CASES_MOVING`).
     ///
     /// "Behind" is the body's inside, not the side the node started on: a turning triangle
     /// can sweep past a node in the first instants of the step, so the generator (which places
@@ -682,17 +690,14 @@ proptest! {
     /// front, ends in front, as it should, and was counted as passing through when the side
     /// was taken from the start (about 1 case in 10⁴).
     ///
-    /// FAILS. Over 200 000 cases: 0.54 % of those with ν > 0 end through (depth behind the
-    /// plane median 0.11 mm, max 6.9 mm; half deeper than the 0.1 mm skin) and 36 % of those
-    /// with ν = 0 (median 35 µm, max 9 mm); 9.4 % overall, both broad phases alike; none when
-    /// the same triangles only translate. The node is caught at t_c and leaves the contact
-    /// point at the relative normal speed νa (0 for ν = 0), sliding on; the turning triangle's
-    /// plane catches up with it later in the step, over the interior. `Collider::node_pass`
-    /// never tests a node again against a triangle it met in the pass (`met`), although the
-    /// narrow phase finds the second meeting on the resolved motion. A deterministic instance:
+    /// Failed before session 15: over 200 000 cases, 0.54 % of those with ν > 0 ended through
+    /// (depth behind the plane median 0.11 mm, max 6.9 mm) and 36 % of those with ν = 0 (median
+    /// 35 µm, max 9 mm), 9.4 % overall. The node is caught at t_c and leaves the contact point at
+    /// the relative normal speed νa (0 for ν = 0), sliding on; the turning triangle's plane
+    /// catches up with it later in the step, over the interior, and `node_pass` did not look
+    /// for a second meeting. A deterministic instance:
     /// `a_turning_body_triangle_overtakes_the_node_it_caught`.
     #[test]
-    #[ignore = "fails: a turning body triangle meets the node again later in the step, after the contact, and node_pass never tests a triangle it met again (`met`); 9.4 % of cases (0.54 % with ν > 0, 36 % with ν = 0), e.g. a_turning_body_triangle_overtakes_the_node_it_caught"]
     fn a_node_aimed_through_a_turning_body_triangle_never_passes(
         x in round_triangle(),
         u in vertex_velocities(),
@@ -715,21 +720,18 @@ proptest! {
     /// node (moving on p + v′₃t) must not end the step on the other side of the triangle
     /// (vertices on x_k + v′_k t), more than 1e-12 m behind it, having last passed its plane
     /// through the closed triangle (weights ≥ −5e-10, the independent root search). 2048 cases
-    /// (`CASES_IGNORED`).
+    /// (`CASES_MOVING`).
     ///
-    /// FAILS. Over 200 000 cases: 0.36 % of those with ν > 0 end through (median depth 1.0 mm,
-    /// max 6.2 cm) and 4.5 % of those with ν = 0 (median 0.9 mm, max 5.6 cm); 1.4 % overall;
-    /// every crossing comes after the contact. It is the second meeting of the turning body
-    /// triangle (0.55 % of the cases with the triangle's nodes 10⁶ times heavier, so that only
-    /// their own motion turns it), and it happens as well to a triangle that only translated
-    /// before the contact (0.22 %): the impulse changes each vertex's velocity by −J·w_k/m_k for
-    /// the whole step, so the vertex nearest the hit recedes fastest and the triangle turns; a
-    /// node leaving the contact point at the relative normal speed νa and sliding towards its
-    /// slower part runs into it. The contact-point guarantee holds in all of them; self-contact
-    /// has no recovery, so a node that ended through stays on the wrong side. A deterministic
-    /// instance: `a_kicked_cloth_triangle_turns_into_the_node_that_kicked_it`.
+    /// Failed before session 15: over 200 000 cases, 0.36 % of those with ν > 0 ended through
+    /// (median depth 1.0 mm, max 6.2 cm) and 4.5 % of those with ν = 0 (median 0.9 mm, max
+    /// 5.6 cm), 1.4 % overall, every crossing after the contact: the turning triangle's second
+    /// meeting, and also that of a triangle that only translated before the contact — the
+    /// impulse changes each vertex's velocity by −J·w_k/m_k for the whole step, so the vertex
+    /// nearest the hit recedes fastest and the triangle turns; a node leaving the contact point
+    /// at the relative normal speed νa and sliding towards its slower part runs into it.
+    /// Self-contact has no recovery, so a node that ended through stayed on the wrong side. A
+    /// deterministic instance: `a_kicked_cloth_triangle_turns_into_the_node_that_kicked_it`.
     #[test]
-    #[ignore = "fails: the free cloth triangle, turned by the contact's impulse or its own motion, meets the node again later in the step, and node_pass never tests a triangle it met again (`met`); 1.4 % of cases (0.36 % with ν > 0), e.g. a_kicked_cloth_triangle_turns_into_the_node_that_kicked_it"]
     fn a_cloth_node_aimed_through_a_free_cloth_triangle_never_passes(
         x in round_triangle(),
         u in vertex_velocities(),
@@ -813,17 +815,16 @@ fn unresolved_cases_tunnel_and_the_checks_say_so() {
         .expect("resolved");
 }
 
-/// A deterministic instance of the failure of
+/// A deterministic instance of the (fixed) failure of
 /// `a_node_aimed_through_a_turning_body_triangle_never_passes`. The unit triangle in z = 0
 /// turns about its x-axis edge (vertex 2 rises at 5 m/s: the plane is at height 5·y·t). A node
 /// 1 mm above (0.2, 0.05) moving at (0, 15, −1) m/s meets it at t_c ≈ 0.77 ms near y = 0.06
 /// (approach ≈ 1.3 m/s); with ν = ρ = 0 it leaves the contact point at the plane's local normal
 /// speed (≈ 0.3 m/s) and slides on towards y = 0.2, where the plane rises at 1 m/s. Asserts,
 /// as the property test, that it does not end the step behind the triangle having passed
-/// through it; it does: through at t = 3.7 ms, 6.4 mm behind at the end of the step — deeper
-/// than the 5 mm recovery depth, so recovery would not move it out either.
+/// through it. Before session 15 it did: through at t = 3.7 ms, 6.4 mm behind at the end of the
+/// step — deeper than the 5 mm recovery depth, so recovery would not have moved it out either.
 #[test]
-#[ignore = "fails: the node caught at t = 0.77 ms slides on and the turning triangle overtakes it; `met` in node_pass never tests the triangle again"]
 fn a_turning_body_triangle_overtakes_the_node_it_caught() {
     let x = unit_triangle();
     let u = [V3::zeros(), V3::zeros(), V3::new(0.0, 0.0, 5.0)];
@@ -843,16 +844,15 @@ fn a_turning_body_triangle_overtakes_the_node_it_caught() {
     }
 }
 
-/// A deterministic instance of the failure of
+/// A deterministic instance of the (fixed) failure of
 /// `a_cloth_node_aimed_through_a_free_cloth_triangle_never_passes`: a free cloth triangle at
 /// rest (the unit triangle, 1 g nodes) is hit near vertex 0 (weights ≈ (0.79, 0.1, 0.11)) by a
 /// 1 g node at (0, 15, −10) m/s, with ν = ρ = 0. The impulse sends vertex 0 off at −4.8 m/s and
 /// vertices 1 and 2 at −0.6 m/s; the node follows the contact point down at −4.2 m/s while it
-/// slides towards vertex 2, runs into the slower part of the triangle at t = 7.0 ms and ends
-/// 3.9 mm behind it — although it ends on its own side of the point it hit (asserted too; that
-/// holds).
+/// slides towards vertex 2, and before session 15 it ran into the slower part of the triangle at
+/// t = 7.0 ms and ended 3.9 mm behind it — although it ended on its own side of the point it hit
+/// (asserted too; that held).
 #[test]
-#[ignore = "fails: the cloth triangle turned by the contact meets the node again after it; `met` in node_pass never tests the triangle again"]
 fn a_kicked_cloth_triangle_turns_into_the_node_that_kicked_it() {
     let x = unit_triangle();
     let case = Case {

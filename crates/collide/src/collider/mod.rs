@@ -7,13 +7,18 @@ use rayon::prelude::*;
 use crate::broad::{BroadPhase, new_broad};
 use crate::geom::V3;
 pub use crate::geom::closest_point;
-use crate::narrow::{Hit, NarrowTest, Sides, point_triangle, point_triangle_thesis};
+use crate::narrow::{
+    Hit, NarrowTest, Sides, last_pass_through, point_triangle, point_triangle_thesis,
+};
 use crate::parts::{Motion, PartsError, RigidParts};
 use crate::response::respond;
 
 pub use params::{ContactError, ContactParams, ContactPlane};
 
-use node::{MAX_CONTACTS, NodeOutcome, NodeView, nearest_outside, recover, tangent_plane};
+use node::{
+    MAX_AGAIN, MAX_CONTACTS, NodeOutcome, NodeView, PASS_DEPTH, cloth_velocity, nearest_outside,
+    push_out, recover, side_of, tangent_plane,
+};
 
 mod node;
 mod params;
@@ -51,6 +56,11 @@ pub struct PassStats {
     pub transferred: usize,
     /// Nodes found inside the body (shallower than the recovery depth) and moved out.
     pub recovered: usize,
+    /// Contacts taken again with a turning or deforming triangle a node had met in the pass
+    /// (counted in `body_hits` and `self_hits` too).
+    pub again: usize,
+    /// Nodes put on the end plane of such a triangle after `MAX_AGAIN` contacts taken again.
+    pub pushed: usize,
     /// Nodes given a contact plane for the shape iterations (within `plane_reach` of the body,
     /// or inside it, at the start of the step).
     pub planes: usize,
@@ -514,6 +524,8 @@ impl Collider {
         self.stats.body_hits += r.body_hits;
         self.stats.self_hits += r.self_hits;
         self.stats.recovered += usize::from(r.recovered);
+        self.stats.again += r.again;
+        self.stats.pushed += usize::from(r.pushed);
         if let Some(v) = r.velocity {
             velocities[i] = v;
         }
@@ -527,8 +539,11 @@ impl Collider {
 
     /// One node's contacts in a pass: its earliest contact, then (with its corrected motion)
     /// the earliest with a surface it has not met yet, up to `MAX_CONTACTS` — a node in a crease
-    /// between two parts meets both. Reads the node's own velocity (and, with self-collision,
-    /// the velocities of the cloth triangles it meets); returns what changes.
+    /// between two parts meets both. A triangle it has met is not hit again unless it turned or
+    /// deformed into the corrected path, so that the node would end the step behind it having
+    /// passed through it; then the contact is taken again at that last passage. Reads the node's
+    /// own velocity (and, with self-collision, the velocities of the cloth triangles it meets, as
+    /// its contacts in this pass change them); returns what changes.
     fn node_pass(
         &self,
         i: usize,
@@ -551,12 +566,17 @@ impl Collider {
         let mut out = NodeOutcome::default();
         let pi = positions[i];
         let mut vi = velocities[i];
-        let mut met: [(usize, bool); MAX_CONTACTS] = [(usize::MAX, false); MAX_CONTACTS];
-        for round in 0..MAX_CONTACTS {
+        // The triangles met so far: (triangle, whether it is the cloth's, the side the node
+        // came from as ±1 times the triangle's counter-clockwise normal).
+        let mut met: [(usize, bool, f64); MAX_CONTACTS] = [(usize::MAX, false, 1.0); MAX_CONTACTS];
+        let mut n_met = 0;
+        let mut again_left = MAX_AGAIN;
+        loop {
             let end = pi + vi * dt;
+            let new = n_met < MAX_CONTACTS;
             // Earliest contact: (hit, triangle, whether it is the cloth's).
             let mut best: Option<(Hit, usize, bool)> = None;
-            if let Some(body) = self.body.as_ref() {
+            if new && let Some(body) = self.body.as_ref() {
                 candidates.clear();
                 body.broad.query(&pi, &end, p.thickness, candidates);
                 out.candidates += candidates.len();
@@ -570,14 +590,17 @@ impl Collider {
                             continue;
                         }
                         if best.is_none_or(|b| hit.time < b.0.time)
-                            && !met[..round].contains(&(t as usize, false))
+                            && !met[..n_met]
+                                .iter()
+                                .any(|m| (m.0, m.1) == (t as usize, false))
                         {
                             best = Some((hit, t as usize, false));
                         }
                     }
                 }
             }
-            if p.self_collision
+            if new
+                && p.self_collision
                 && let Some(broad) = self.cloth_broad.as_ref()
             {
                 candidates.clear();
@@ -597,14 +620,33 @@ impl Collider {
                     let u = tri.map(|k| &velocities[k as usize]);
                     if let Some(hit) = test(&pi, &vi, x, u, dt, p.thickness, Sides::Both)
                         && best.is_none_or(|b| hit.time < b.0.time)
-                        && !met[..round].contains(&(t as usize, true))
+                        && !met[..n_met]
+                            .iter()
+                            .any(|m| (m.0, m.1) == (t as usize, true))
                     {
                         best = Some((hit, t as usize, true));
                     }
                 }
             }
+            // A triangle met before that turned or deformed into the corrected path: the node
+            // would end the step behind it, having passed through it after the contact.
+            for &(t, is_cloth, side) in met[..n_met].iter().filter(|_| again_left > 0) {
+                let (x, u) = self.met_motion(t, is_cloth, view, &out.cloth_dv);
+                if let Some(hit) = last_pass_through(
+                    &pi,
+                    &vi,
+                    [&x[0], &x[1], &x[2]],
+                    [&u[0], &u[1], &u[2]],
+                    dt,
+                    side,
+                    PASS_DEPTH,
+                ) && best.is_none_or(|b| hit.time < b.0.time)
+                {
+                    best = Some((hit, t, is_cloth));
+                }
+            }
             let Some((hit, t, is_cloth)) = best else {
-                if round == 0
+                if n_met == 0
                     && p.recovery_depth > p.thickness
                     && self.parts.is_none()
                     && let Some(body) = self.body.as_ref()
@@ -616,19 +658,39 @@ impl Collider {
                 }
                 break;
             };
-            met[round] = (t, is_cloth);
+            let again = met[..n_met].iter().any(|m| (m.0, m.1) == (t, is_cloth));
             let (tri, inv_mu, u) = if is_cloth {
                 let tri = triangles[t];
                 (
                     tri,
                     tri.map(|k| inverse_masses[k as usize]),
-                    tri.map(|k| velocities[k as usize]),
+                    // Met again: as this pass has moved it.
+                    tri.map(|k| {
+                        if again {
+                            cloth_velocity(k as usize, velocities, &out.cloth_dv)
+                        } else {
+                            velocities[k as usize]
+                        }
+                    }),
                 )
             } else {
                 let body = self.body.as_ref().expect("body hit");
                 let tri = body.triangles[t];
                 (tri, [0.0; 3], tri.map(|k| body.vel[k as usize]))
             };
+            if again {
+                again_left -= 1;
+                out.again += 1;
+            } else {
+                let x = if is_cloth {
+                    tri.map(|k| positions[k as usize])
+                } else {
+                    let body = self.body.as_ref().expect("body hit");
+                    tri.map(|k| body.start[k as usize])
+                };
+                met[n_met] = (t, is_cloth, side_of(&hit, &x, &u));
+                n_met += 1;
+            }
             let Some(r) = respond(
                 &vi,
                 inverse_masses[i],
@@ -668,6 +730,54 @@ impl Collider {
                 out.body_hits += 1;
             }
         }
+        {
+            // The contacts taken again did not keep the node in front of a turning triangle:
+            // put its end on the triangle's end plane (`push_out`).
+            for &(t, is_cloth, side) in &met[..n_met] {
+                let (tri, inv_mu) = if is_cloth {
+                    let tri = triangles[t];
+                    (tri, tri.map(|k| inverse_masses[k as usize]))
+                } else {
+                    (self.body.as_ref().expect("body hit").triangles[t], [0.0; 3])
+                };
+                let (x, u) = self.met_motion(t, is_cloth, view, &out.cloth_dv);
+                let dv = push_out(&pi, &mut vi, inverse_masses[i], &x, &u, inv_mu, dt, side);
+                if let Some(dv) = dv {
+                    out.velocity = Some(vi);
+                    out.pushed = true;
+                    if is_cloth {
+                        for (&k, dv) in tri.iter().zip(dv) {
+                            out.cloth_dv.push((k as usize, dv));
+                        }
+                    }
+                }
+            }
+        }
         out
+    }
+
+    /// The start vertices and velocities of a triangle a node has met (a cloth triangle's
+    /// velocities as this node's contacts in the pass have changed them: `dv`).
+    fn met_motion(
+        &self,
+        t: usize,
+        is_cloth: bool,
+        view: &NodeView<'_>,
+        dv: &[(usize, V3)],
+    ) -> ([V3; 3], [V3; 3]) {
+        if is_cloth {
+            let tri = view.triangles[t];
+            (
+                tri.map(|k| view.positions[k as usize]),
+                tri.map(|k| cloth_velocity(k as usize, view.velocities, dv)),
+            )
+        } else {
+            let body = self.body.as_ref().expect("body hit");
+            let tri = body.triangles[t];
+            (
+                tri.map(|k| body.start[k as usize]),
+                tri.map(|k| body.vel[k as usize]),
+            )
+        }
     }
 }
