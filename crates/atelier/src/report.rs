@@ -323,6 +323,9 @@ pub struct TryonInfo {
     pub termination: String,
     /// The fitted camera.
     pub camera: Camera,
+    /// With the camera's direction searched (`--yaw search`): every direction tried, degrees,
+    /// and its fit's silhouette overlap, in the order tried; empty when the direction was given.
+    pub yaw_tried: Vec<(f64, f64)>,
     /// The fitted sizes.
     pub sizes: Sizes,
     /// Fitted joint angles (α, β, γ), degrees, by part.

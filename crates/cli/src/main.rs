@@ -82,14 +82,16 @@ enum Command {
         #[arg(long, value_name = "START.ron")]
         pose: Option<PathBuf>,
         /// The camera's direction round the vertical, degrees (0 from the front, 90 from the
-        /// body's left).
+        /// body's left), or `search` when it is not known (the fit is run over directions from
+        /// −90° to 90° and the best overlap kept; about 13 fits).
         #[arg(
             long,
-            value_name = "DEG",
-            default_value_t = 0.0,
+            value_name = "DEG|search",
+            default_value = "0",
+            value_parser = parse_yaw,
             allow_negative_numbers = true
         )]
-        yaw: f64,
+        yaw: Yaw,
         /// The person's height, cm (default: the body description's).
         #[arg(long, value_name = "CM")]
         height: Option<f64>,
@@ -185,7 +187,7 @@ fn main() -> ExitCode {
         }) => {
             let mut inputs = atelier_tryon::TryonInputs::new(photo, mask, garment);
             inputs.pose = pose;
-            inputs.yaw_deg = yaw;
+            inputs.yaw_deg = yaw.0;
             inputs.height_cm = height;
             if let Some(l) = light {
                 inputs.light = l;
@@ -265,6 +267,23 @@ fn run_scenario(
 }
 
 /// `x,y,z`: three finite numbers, not all zero.
+/// `--yaw`: degrees, or `None` for `search`.
+#[derive(Clone, Copy, Debug)]
+struct Yaw(Option<f64>);
+
+fn parse_yaw(text: &str) -> Result<Yaw, String> {
+    if text.trim() == "search" {
+        return Ok(Yaw(None));
+    }
+    match text.trim().parse::<f64>() {
+        Ok(d) if d.is_finite() && (-180.0..=180.0).contains(&d) => Ok(Yaw(Some(d))),
+        Ok(_) => Err(format!(
+            "`{text}`: a direction from -180 to 180 degrees, or `search`"
+        )),
+        Err(e) => Err(format!("`{text}`: {e} (give degrees, or `search`)")),
+    }
+}
+
 fn parse_light(text: &str) -> Result<[f64; 3], String> {
     let v: Vec<f64> = text
         .split(',')

@@ -665,9 +665,29 @@ fn tryon_runs_the_fixture_and_refuses_a_mask_of_another_picture() {
     ]);
     assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("not all zero"), "{stderr}");
+    // A direction that is neither degrees nor `search` is refused the same way.
+    let (code, _, stderr) = status(&[
+        "tryon",
+        "--photo",
+        "p.png",
+        "--garment",
+        "g.ron",
+        "--yaw",
+        "north",
+        "--out",
+        &out_s,
+    ]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("`north`") && stderr.contains("search"),
+        "{stderr}"
+    );
     // Help is not an error.
     let (code, stdout, _) = status(&["tryon", "--help"]);
     assert_eq!(code, Some(0));
-    assert!(stdout.contains("--yaw"), "{stdout}");
+    assert!(
+        stdout.contains("--yaw") && stdout.contains("search"),
+        "{stdout}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -8,6 +8,7 @@ pub mod composite;
 pub mod examples;
 pub mod image;
 pub mod pose;
+pub mod yaw;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -48,8 +49,9 @@ pub struct TryonInputs {
     pub garment: PathBuf,
     /// A start pose (RON, [`PoseFile`]); `None`: the standard pose.
     pub pose: Option<PathBuf>,
-    /// The camera's direction round the vertical, degrees (0: from the front).
-    pub yaw_deg: f64,
+    /// The camera's direction round the vertical, degrees (0: from the front); `None`: unknown,
+    /// searched ([`yaw::fit_pose_any_yaw`]).
+    pub yaw_deg: Option<f64>,
     /// The person's height, cm; `None`: the body description's.
     pub height_cm: Option<f64>,
     /// Direction towards the light, body frame (x the body's left, y up, z forward).
@@ -69,7 +71,7 @@ impl TryonInputs {
             mask,
             garment,
             pose: None,
-            yaw_deg: 0.0,
+            yaw_deg: Some(0.0),
             height_cm: None,
             light: DEFAULT_LIGHT,
             colour: atelier::picture::CLOTH,
@@ -198,16 +200,20 @@ pub fn tryon(
         }
     };
     let height_cm = inputs.height_cm.unwrap_or(description.sizes.height_cm);
-    let fit = pose::fit_pose(
-        &mask,
-        &FitOptions {
-            description: description.clone(),
-            height_cm,
-            yaw_deg: inputs.yaw_deg,
-            start,
+    let fit_options = FitOptions {
+        description: description.clone(),
+        height_cm,
+        yaw_deg: inputs.yaw_deg.unwrap_or(0.0),
+        start,
+    };
+    let (fit, yaw_tried) = match inputs.yaw_deg {
+        Some(_) => (pose::fit_pose(&mask, &fit_options), Vec::new()),
+        None => match yaw::fit_pose_any_yaw(&mask, &fit_options) {
+            Ok(s) => (Ok(s.fit), s.tried),
+            Err(e) => (Err(e), Vec::new()),
         },
-    )
-    .map_err(TryonError::Input)?;
+    };
+    let fit = fit.map_err(TryonError::Input)?;
     progress(0.1);
 
     // The garment on the fitted mannequin, moved from the standard pose to the fitted one.
@@ -281,7 +287,7 @@ pub fn tryon(
         .as_bytes(),
     )?;
 
-    let info = info(inputs, &mask, &fit, &fitted, motion_s, &picture);
+    let info = info(inputs, &mask, &fit, &fitted, motion_s, &picture, yaw_tried);
     let setup = (clock.elapsed().as_secs_f64() - sim.wall_seconds).max(0.0);
     let mut warnings = fit_warnings(&mask, &fit);
     if spec.motion.is_some() {
@@ -321,6 +327,7 @@ fn info(
     fitted: &PoseFile,
     motion_s: f64,
     picture: &composite::Composite,
+    yaw_tried: Vec<(f64, f64)>,
 ) -> TryonInfo {
     TryonInfo {
         photo: inputs.photo.display().to_string(),
@@ -332,6 +339,7 @@ fn info(
         evaluations: fit.evaluations,
         termination: fit.termination.clone(),
         camera: fit.camera,
+        yaw_tried,
         sizes: fit.sizes,
         joints: fitted.joints.clone(),
         motion_s,

@@ -272,6 +272,29 @@ pub fn posed_mannequin(
     Ok((posed(&body, angles), body.rest.triangles.clone()))
 }
 
+/// Where the fitted mannequin's joints appear in the photograph: the pixel (column, row) of
+/// every part's joint centre (its pivot: a forearm's is the elbow, a hand's the wrist, a shin's
+/// the knee, a foot's the ankle), posed at the fit's angles and sizes, through its camera.
+pub fn joint_pixels(
+    description: &BodyDescription,
+    fit: &PoseFit,
+) -> Result<[[f64; 2]; 17], String> {
+    let mannequin =
+        Mannequin::from_description(description, &fit.sizes).map_err(|e| e.to_string())?;
+    let body = Body::new(mannequin);
+    let list: Vec<(Part, [f64; 3])> = Part::ALL
+        .iter()
+        .map(|&p| (p, fit.angles[p.index()]))
+        .collect();
+    let rate = PoseRate {
+        pose: Pose::from_angles(&list, V3::zeros()),
+        omega: [V3::zeros(); 17],
+        root_velocity: V3::zeros(),
+    };
+    let frames = body.frames(&rate);
+    Ok(frames.map(|f| fit.camera.pixel([f.pivot.x, f.pivot.y, f.pivot.z])))
+}
+
 /// The vertices of `body` posed at `angles`.
 fn posed(body: &Body, angles: &[[f64; 3]; 17]) -> Vec<[f64; 3]> {
     let list: Vec<(Part, [f64; 3])> = Part::ALL.iter().map(|&p| (p, angles[p.index()])).collect();

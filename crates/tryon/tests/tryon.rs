@@ -128,7 +128,7 @@ fn the_composite_keeps_the_photograph_outside_the_garment() {
         Some(dir.join("mask.png")),
         root().join("fixtures/scenarios/skirt_sewn.ron"),
     );
-    inputs.yaw_deg = e.camera.yaw_deg;
+    inputs.yaw_deg = Some(e.camera.yaw_deg);
     let out = dir.join("out");
     let report = tryon(&inputs, &out, &RunOptions::default(), &mut |_| {}).expect("tryon");
     assert!(report.passed(), "{}", report.summary_line());

@@ -105,7 +105,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
             Some(dir.join("mask.png")),
             garment.clone(),
         );
-        inputs.yaw_deg = e.camera.yaw_deg;
+        inputs.yaw_deg = Some(e.camera.yaw_deg);
         let clock = std::time::Instant::now();
         let report = tryon(
             &inputs,
@@ -170,7 +170,7 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     let e = &examples()[1];
     let dir = out.join(e.name);
     let mut inputs = TryonInputs::new(dir.join("photo.png"), None, garment);
-    inputs.yaw_deg = e.camera.yaw_deg;
+    inputs.yaw_deg = Some(e.camera.yaw_deg);
     let report = tryon(
         &inputs,
         &dir.join("segmented"),
