@@ -85,7 +85,11 @@ fn a_makehuman_body_goes_round_the_range_image_loop() {
         e.table()
     );
     for (part, s) in &e.parts {
-        assert!(s.triangles > 0, "{} missing from the gridded body", part.name());
+        assert!(
+            s.triangles > 0,
+            "{} missing from the gridded body",
+            part.name()
+        );
     }
     assert!(
         e.total.mean_abs_mm <= 1.5,
