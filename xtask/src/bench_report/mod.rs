@@ -50,12 +50,13 @@ pub enum Step {
     Scenarios,
 }
 
-/// The benchmark scenarios timed in the report.
-const SCENARIOS: [&str; 6] = [
+/// The benchmark scenarios timed in the report. `dress_walk_self_collision` is not one since
+/// session 15: on the converged step it did not finish in 45 minutes (docs/validation.md), more
+/// than the whole report; `garment/step_walking_self_collision` times its step.
+const SCENARIOS: [&str; 5] = [
     "default",
     "dress_sewn",
     "dress_walk",
-    "dress_walk_self_collision",
     "drape_jis_cotton_broad",
     "wet_pinch1_air400",
 ];

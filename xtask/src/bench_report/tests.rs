@@ -39,3 +39,22 @@ fn a_missing_input_names_the_template_line_and_writes_nothing() {
     assert!(err.contains("performance.md.in:2"), "{err}");
     assert!(err.contains("performance.md.in:3"), "{err}");
 }
+
+#[test]
+fn the_templates_scenarios_are_the_ones_the_report_runs() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("performance.md.in");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut named = Vec::new();
+    for line in text.lines().filter_map(|l| l.strip_prefix("@@scenarios ")) {
+        for item in line.split_whitespace() {
+            named.push(item.split('=').next().unwrap().to_string());
+        }
+    }
+    let mut run: Vec<String> = SCENARIOS.iter().map(|s| s.to_string()).collect();
+    named.sort();
+    run.sort();
+    assert_eq!(
+        named, run,
+        "the template's @@scenarios and SCENARIOS differ"
+    );
+}
