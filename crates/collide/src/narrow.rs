@@ -139,13 +139,16 @@ pub fn point_triangle(
             }
         }
     }
-    // Behind a body triangle's plane at the start: a translating triangle cannot be met from
-    // the front in this step (the distance is linear in time). One that turns can sweep past a
-    // node beside it and be met from the front later in the step.
-    if sides == Sides::Front && s0 < -thickness && u[1] == u[0] && u[2] == u[0] {
+    let coeffs = coplanarity(p, v, x, u);
+    // Behind a body triangle's plane at the start: a triangle that turns can sweep past a node
+    // beside it and be met from the front later in the step, so the node is skipped only if it
+    // stays behind the plane all step — every Bernstein coefficient of the coplanarity cubic on
+    // [0, Δt] negative (the cubic lies in their convex hull). A translating triangle's distance
+    // is linear in time: then this is "behind at the start and at the end".
+    if sides == Sides::Front && s0 < -thickness && behind_all_step(coeffs, dt) {
         return None;
     }
-    for t in cubic_roots_in(coplanarity(p, v, x, u), dt) {
+    for t in cubic_roots_in(coeffs, dt) {
         let xt = [0, 1, 2].map(|k| x[k] + u[k] * t);
         let pt = p + v * t;
         let w = barycentric(&pt, [&xt[0], &xt[1], &xt[2]]);
@@ -219,6 +222,24 @@ pub fn last_pass_through(
         weights: w,
         normal: nt,
     })
+}
+
+/// Whether the cubic `c₀ + c₁t + c₂t² + c₃t³` is negative on all of `[0, T]`, by its Bernstein
+/// coefficients on that interval (sufficient: the cubic lies in their convex hull).
+fn behind_all_step(c: [f64; 4], t_max: f64) -> bool {
+    let a = [
+        c[0],
+        c[1] * t_max,
+        c[2] * t_max * t_max,
+        c[3] * t_max * t_max * t_max,
+    ];
+    let b = [
+        a[0],
+        a[0] + a[1] / 3.0,
+        a[0] + 2.0 * a[1] / 3.0 + a[2] / 3.0,
+        a[0] + a[1] + a[2] + a[3],
+    ];
+    b.iter().all(|&v| v < 0.0)
 }
 
 /// The coefficients (constant first) of the coplanarity cubic
@@ -510,6 +531,18 @@ mod tests {
             )
             .is_none()
         );
+    }
+
+    #[test]
+    fn behind_all_step_needs_the_whole_interval() {
+        // −1 − t: negative throughout.
+        assert!(behind_all_step([-1.0, -1.0, 0.0, 0.0], 1.0));
+        // −1 + 10t − 10t²: −1 at both ends, +1.5 at t = 0.5.
+        assert!(!behind_all_step([-1.0, 10.0, -10.0, 0.0], 1.0));
+        // −1 + t³ on [0, 2]: 7 at the end.
+        assert!(!behind_all_step([-1.0, 0.0, 0.0, 1.0], 2.0));
+        // −1 + t³ on [0, 0.5]: −0.875 at the end, negative throughout.
+        assert!(behind_all_step([-1.0, 0.0, 0.0, 1.0], 0.5));
     }
 
     #[test]
