@@ -24,7 +24,10 @@
 //!   synthetic objects: Table 1, Fig. 11, Table 3 and the reproduced shapes.
 //! - `cargo xtask bench-report [--out DIR] [--skip STEP…]` — every criterion bench, the
 //!   time-against-error studies, the stability map, the peers and the benchmark scenarios, then
-//!   `docs/performance.md` regenerated from `xtask/performance.md.in` (about an hour on 2 cores).
+//!   `docs/performance.md` regenerated from `xtask/performance.md.in`. On the converged step this
+//!   takes well over two hours on 2 cores (session 15: the criterion benches 70 min, the
+//!   stability map 9 min, the time-against-error study of the dress over 30 min unfinished — its
+//!   two references alone 8 and 11 min).
 //! - `cargo xtask knob-table [--check]` — the table of `StepParams`' knobs in `docs/solver.md`
 //!   regenerated from `StepParams::default()` and the doc comments of `params.rs`; `--check`
 //!   fails if the file is out of date (so does `cargo test --workspace`).
@@ -83,7 +86,7 @@ enum Command {
         shard: Option<String>,
     },
     /// Run the benches, figures, peers and benchmark scenarios and regenerate
-    /// docs/performance.md from xtask/performance.md.in (about an hour on 2 cores).
+    /// docs/performance.md from xtask/performance.md.in (over two hours on 2 cores).
     BenchReport {
         /// Output folder for the run's figures, peers and scenarios (created if missing);
         /// default `target/bench-report` in the repository.

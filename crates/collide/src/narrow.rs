@@ -517,7 +517,7 @@ mod tests {
         assert!(hit.normal.z > 0.0, "{hit:?}");
         // The triangle translating instead (every vertex at −25 m/s, its speed under the
         // point's start): d(t) = −0.005 + 6t, out in front at 0.83 ms and in front to the end,
-        // so never met from the front (the early return for a translating triangle).
+        // so never met from the front (its one plane crossing is from behind).
         let ut = [V3::new(0.0, 0.0, -25.0); 3];
         assert!(
             point_triangle(

@@ -75,7 +75,7 @@ pub fn run(root: &Path, out: &Path, skip: &[Step]) -> Result<()> {
         for dir in ["criterion", "atelier-bench"] {
             remove_dir(&target.join(dir))?;
         }
-        eprintln!("bench-report: cargo bench --workspace (criterion, about 25 minutes)");
+        eprintln!("bench-report: cargo bench --workspace (criterion, about 70 minutes)");
         let status = Command::new(env_or("CARGO", "cargo"))
             // No criterion plots: its plotting backend needs a system font this machine may
             // lack (it panics without one), and the report reads the numbers, not the plots.
