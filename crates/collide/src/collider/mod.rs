@@ -571,6 +571,9 @@ impl Collider {
         let mut met: [(usize, bool, f64); MAX_CONTACTS] = [(usize::MAX, false, 1.0); MAX_CONTACTS];
         let mut n_met = 0;
         let mut again_left = MAX_AGAIN;
+        // Whether the last round asked every met triangle `last_pass_through` with the node's
+        // final motion and none answered (then the failsafe below has nothing to do).
+        let mut settled = false;
         loop {
             let end = pi + vi * dt;
             let new = n_met < MAX_CONTACTS;
@@ -656,6 +659,7 @@ impl Collider {
                     out.velocity = Some(vi);
                     out.recovered = true;
                 }
+                settled = again_left > 0;
                 break;
             };
             let again = met[..n_met].iter().any(|m| (m.0, m.1) == (t, is_cloth));
@@ -730,9 +734,10 @@ impl Collider {
                 out.body_hits += 1;
             }
         }
-        {
-            // The contacts taken again did not keep the node in front of a turning triangle:
-            // put its end on the triangle's end plane (`push_out`).
+        if !settled {
+            // The contacts taken again (all of `MAX_AGAIN`, or one the response refused) may
+            // not have kept the node in front of a turning triangle: put its end on the
+            // triangle's end plane (`push_out`).
             for &(t, is_cloth, side) in &met[..n_met] {
                 let (tri, inv_mu) = if is_cloth {
                     let tri = triangles[t];
