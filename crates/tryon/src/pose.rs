@@ -281,30 +281,24 @@ pub fn joint_pixels(
 ) -> Result<[[f64; 2]; 17], String> {
     let mannequin =
         Mannequin::from_description(description, &fit.sizes).map_err(|e| e.to_string())?;
-    let body = Body::new(mannequin);
-    let list: Vec<(Part, [f64; 3])> = Part::ALL
-        .iter()
-        .map(|&p| (p, fit.angles[p.index()]))
-        .collect();
-    let rate = PoseRate {
+    let frames = Body::new(mannequin).frames(&at_rest(&fit.angles));
+    Ok(frames.map(|f| fit.camera.pixel([f.pivot.x, f.pivot.y, f.pivot.z])))
+}
+
+/// The pose at `angles` (degrees, by part), held still, the root at the origin.
+fn at_rest(angles: &[[f64; 3]; 17]) -> PoseRate {
+    let list: Vec<(Part, [f64; 3])> = Part::ALL.iter().map(|&p| (p, angles[p.index()])).collect();
+    PoseRate {
         pose: Pose::from_angles(&list, V3::zeros()),
         omega: [V3::zeros(); 17],
         root_velocity: V3::zeros(),
-    };
-    let frames = body.frames(&rate);
-    Ok(frames.map(|f| fit.camera.pixel([f.pivot.x, f.pivot.y, f.pivot.z])))
+    }
 }
 
 /// The vertices of `body` posed at `angles`.
 fn posed(body: &Body, angles: &[[f64; 3]; 17]) -> Vec<[f64; 3]> {
-    let list: Vec<(Part, [f64; 3])> = Part::ALL.iter().map(|&p| (p, angles[p.index()])).collect();
-    let rate = PoseRate {
-        pose: Pose::from_angles(&list, V3::zeros()),
-        omega: [V3::zeros(); 17],
-        root_velocity: V3::zeros(),
-    };
     let mut out = Posed::default();
-    body.pose_into(&rate, &mut out);
+    body.pose_into(&at_rest(angles), &mut out);
     out.positions.iter().map(|p| [p.x, p.y, p.z]).collect()
 }
 
