@@ -49,6 +49,9 @@ pub struct GarmentRun {
     pub max_penetration: f64,
     /// Steps after which some node was inside the body (the push not counted).
     pub steps_with_penetration: usize,
+    /// Nodes inside the body after the last step, pushed or not (a push that did not get the
+    /// garment through leaves them there, and the run ends with it).
+    pub inside_at_end: usize,
     /// Largest strain error any step left, and the last step's.
     pub max_strain_error: (f64, f64),
     /// Kinetic energy at the end, J.
@@ -83,6 +86,7 @@ impl GarmentRun {
             timings: Timings::default(),
             max_penetration: 0.0,
             steps_with_penetration: 0,
+            inside_at_end: 0,
             max_strain_error: (0.0, 0.0),
             kinetic_energy: 0.0,
             max_motion_energy: 0.0,
@@ -174,6 +178,7 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
         if outcome.phase == Phase::Motion {
             run.max_motion_energy = run.max_motion_energy.max(r.kinetic_energy);
         }
+        run.inside_at_end = outcome.inside;
         if outcome.phase != Phase::Pushing {
             run.max_penetration = run.max_penetration.max(outcome.depth);
             run.steps_with_penetration += usize::from(outcome.inside > 0);

@@ -779,3 +779,54 @@ fn wet_party_runs_report_their_convergence() {
     }
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// A one-sided push cut short: the skirt, laid out and sewn in front of the body, pushed through
+/// it at 2 m/s² for at most 0.4 s (16 cm: into the body, not through it, which is ~25 cm deep at
+/// the hips). The run ends at the push limit with the nodes inside, which `max_penetration_m`
+/// does not count (the push goes through the body by design); `nodes_inside_at_end` does, so
+/// the scenario's expectation on it is missed and the run does not pass. The same skirt sewn
+/// around the body ends with none inside.
+#[test]
+fn a_push_that_does_not_get_through_leaves_nodes_inside_at_the_end() {
+    let r = root();
+    let text = format!(
+        r#"(
+    name: "short_push",
+    reproduces: "a one-sided push cut short (test)",
+    kind: Garment(
+        garment: "{}/fixtures/patterns/dress/skirt.ron",
+        fabric: "{}/fixtures/fabrics/cotton_broad.ron",
+        placements: [
+            Flat(at: (0.0, 0.98, 0.20)),
+            Flat(at: (0.0, 0.98, 0.19), back: true),
+            Flat(at: (0.0, 0.98, 0.19), back: true),
+        ],
+        settings: (dressing: OneSided(push: 2.0, push_time: 0.4, push_limit: 0.4), settle: 0.1),
+    ),
+    expectations: [(metric: "nodes_inside_at_end", max: 0)],
+)"#,
+        r.display(),
+        r.display()
+    );
+    let pushed = run_text(&text, &temp_dir("short_push"));
+    let inside = pushed.metrics["nodes_inside_at_end"].expect("measured");
+    eprintln!("pushed 0.4 s: {inside} nodes inside at the end");
+    assert!(
+        inside >= 10.0,
+        "{inside} nodes inside; {:?}",
+        pushed.warnings
+    );
+    assert!(
+        pushed
+            .warnings
+            .iter()
+            .any(|w| w.contains("did not get the garment through")),
+        "{:?}",
+        pushed.warnings
+    );
+    assert!(!pushed.expectations_met && !pushed.passed());
+    // Pushing is not counted in the running penetration metrics.
+    assert_eq!(pushed.metrics["max_penetration_m"], Some(0.0));
+    let sewn = run_text(&short_skirt(0.1), &temp_dir("short_skirt_inside"));
+    assert_eq!(sewn.metrics["nodes_inside_at_end"], Some(0.0));
+}

@@ -367,6 +367,7 @@ fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
         "steps_with_penetration",
         Some(run.steps_with_penetration as f64),
     );
+    put("nodes_inside_at_end", Some(run.inside_at_end as f64));
     put("max_strain_error", Some(run.max_strain_error.0));
     put("final_strain_error", Some(run.max_strain_error.1));
     put("kinetic_energy_j", Some(run.kinetic_energy));

@@ -118,6 +118,7 @@ impl ScenarioKind {
                 "simulated_s",
                 "max_penetration_m",
                 "steps_with_penetration",
+                "nodes_inside_at_end",
                 "max_strain_error",
                 "final_strain_error",
                 "kinetic_energy_j",
