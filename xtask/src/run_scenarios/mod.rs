@@ -45,8 +45,8 @@ pub struct Row {
     pub unmet: Vec<String>,
     /// Why the run failed or could not start.
     pub failure: Option<String>,
-    /// Whether `cargo test` runs it in full (`fixtures/scenarios/CI.md`).
-    pub in_ci: bool,
+    /// How `cargo test` runs it: "in full", "shortened" or "–" (`fixtures/scenarios/CI.md`).
+    pub in_ci: &'static str,
     /// The report, when the run produced one.
     #[serde(skip)]
     pub report: Option<Report>,
@@ -156,13 +156,13 @@ pub fn run_all(
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     // The commit the results come from, read before this run writes into docs/.
     let revision = commit(root);
-    let in_ci = ci::lists(root)?.full;
+    let lists = ci::lists(root)?;
     let clock = Instant::now();
     let mut rows = Vec::new();
     for (k, file) in selected.iter().enumerate() {
         eprintln!("[{}/{}] {}", k + 1, selected.len(), stem(file));
         let mut row = run_one(root, file, out);
-        row.in_ci = in_ci.contains(&stem(file));
+        row.in_ci = lists.in_ci(&stem(file));
         eprintln!("    {}", row_line(&row));
         rows.push(row);
     }
@@ -198,12 +198,23 @@ pub fn run_all(
 
 /// Run one scenario file into `out/NAME/`.
 pub(crate) fn run_one(root: &Path, file: &Path, out: &Path) -> Row {
+    match Scenario::load(file) {
+        Ok(scenario) => run_scenario(blank_row(file, root), &scenario, file, out),
+        Err(e) => Row {
+            failure: Some(e.to_string()),
+            ..blank_row(file, root)
+        },
+    }
+}
+
+/// The row of `file` before its run.
+pub(crate) fn blank_row(file: &Path, root: &Path) -> Row {
     let rel = file
         .strip_prefix(root)
         .unwrap_or(file)
         .display()
         .to_string();
-    let mut row = Row {
+    Row {
         name: stem(file),
         file: rel,
         kind: String::new(),
@@ -214,21 +225,19 @@ pub(crate) fn run_one(root: &Path, file: &Path, out: &Path) -> Row {
         expectations_met: false,
         unmet: Vec::new(),
         failure: None,
-        in_ci: false,
+        in_ci: "–",
         report: None,
-    };
-    let scenario = match Scenario::load(file) {
-        Ok(s) => s,
-        Err(e) => {
-            row.failure = Some(e.to_string());
-            return row;
-        }
-    };
+    }
+}
+
+/// Run a scenario read from `file` (or derived from it: [`ci`]'s shortened forms) into
+/// `out/NAME/`, filling in `row`.
+pub(crate) fn run_scenario(mut row: Row, scenario: &Scenario, file: &Path, out: &Path) -> Row {
     row.name = scenario.name.clone();
     row.kind = scenario.kind.name().into();
     let clock = Instant::now();
     let result = run(
-        &scenario,
+        scenario,
         Some(file),
         &base_of(file),
         &out.join(&scenario.name),
@@ -439,7 +448,7 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
             r.simulated_s,
             r.key_metrics,
             expectations,
-            if r.in_ci { "in full" } else { "–" },
+            r.in_ci,
             r.failure
                 .as_deref()
                 .map_or("–".to_string(), |f| f.replace('|', "\\|"))
