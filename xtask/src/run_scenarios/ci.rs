@@ -21,6 +21,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+#[cfg(test)]
 use atelier::scenario::{Scenario, ScenarioKind};
 
 /// The file holding the lists, relative to the repository.
@@ -82,16 +83,19 @@ pub fn lists(root: &Path) -> Result<Lists> {
 }
 
 /// Simulated time of a shortened drape or wet scene, s (the full ones run 1.5–6 s).
+#[cfg(test)]
 pub const SHORT_S: f64 = 0.2;
 
 /// Time under gravity, and of the motion, of a shortened garment scene, s. The dressing (sewing
 /// or pushing, 0.1–0.35 s) is not shortened: it is what the garment expectations are about.
+#[cfg(test)]
 pub const SHORT_GARMENT_S: f64 = 0.05;
 
 /// The metrics whose bound means the same at any time of a run — a largest-so-far, a count of
 /// failures so far, or a quantity the model conserves (Boyle's law: the trapped air at P_a), not a
 /// state the scene reaches at its end — so a shortened run can be held to the full run's bound.
 /// `unconverged_fraction` is held in every run anyway (`Report::passed`).
+#[cfg(test)]
 pub const RUNNING_METRICS: &[&str] = &[
     "unconverged_fraction",
     "unsewn_pairs",
@@ -111,6 +115,7 @@ pub const RUNNING_METRICS: &[&str] = &[
 /// [`SHORT_S`] (drape, wet) or its settling and motion to [`SHORT_GARMENT_S`] (garment), and
 /// its expectations cut to those on [`RUNNING_METRICS`]. `None` for the kinds that have no long
 /// scenarios.
+#[cfg(test)]
 pub fn shortened(scenario: &Scenario) -> Option<Scenario> {
     let mut short = scenario.clone();
     match &mut short.kind {

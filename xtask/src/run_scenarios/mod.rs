@@ -420,6 +420,13 @@ fn summary_markdown(s: &Summary, pictures: Option<&str>) -> String {
     }
     let _ = writeln!(
         md,
+        "The column \"in CI\" says how `cargo test` runs the scenario \
+         (`fixtures/scenarios/CI.md`): in full, every expectation asserted; shortened, its time \
+         cut and held to the expectations that mean the same at any time of a run; or not at all \
+         (a known miss).\n"
+    );
+    let _ = writeln!(
+        md,
         "| scenario | kind | wall s | steps | simulated s | key metrics | expectations | in CI | failure |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
