@@ -151,3 +151,162 @@ fn draw(
     root.present()?;
     Ok(())
 }
+
+/// One pattern piece on a sheet ([`write_pieces`]), cm in the piece's own frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PieceDrawing {
+    /// Name, written under the piece.
+    pub name: String,
+    /// The closed outline (the seam line).
+    pub outline: Vec<(f64, f64)>,
+    /// The grid's edges (thin grey).
+    pub grid: Vec<[(f64, f64); 2]>,
+    /// The grain line, drawn as an arrow.
+    pub grain: Option<[(f64, f64); 2]>,
+    /// Notches (red ticks into the piece are drawn as dots).
+    pub notches: Vec<(f64, f64)>,
+    /// The grid's four corners.
+    pub corners: Vec<(f64, f64)>,
+    /// Darts: first end, apex, second end.
+    pub darts: Vec<[(f64, f64); 3]>,
+    /// Internal lines drawn only.
+    pub lines: Vec<Vec<(f64, f64)>>,
+}
+
+#[cfg(feature = "charts")]
+/// Draw pattern pieces side by side on one sheet, at one scale (cm on both axes): outline
+/// black, grid grey, grain line a green arrow, notches red dots, the grid's corners blue
+/// squares, darts purple, internal lines dashed grey; each piece's name under it. Written
+/// atomically.
+pub fn write_pieces(path: &Path, title: &str, pieces: &[PieceDrawing]) -> std::io::Result<()> {
+    if !font() {
+        return Err(std::io::Error::other(
+            "the bundled font could not be loaded",
+        ));
+    }
+    let tmp = atelier_files::files::temporary_sibling(path);
+    match draw_pieces(&tmp, title, pieces) {
+        Ok(()) => std::fs::rename(&tmp, path),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(std::io::Error::other(e))
+        }
+    }
+}
+
+#[cfg(feature = "charts")]
+fn draw_pieces(
+    file: &Path,
+    title: &str,
+    pieces: &[PieceDrawing],
+) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    // Lay the pieces out in a row, 8 cm apart, bottoms aligned.
+    const GAP: f64 = 8.0;
+    let bounds = |p: &PieceDrawing| {
+        p.outline.iter().fold(
+            (
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            ),
+            |(a, b, c, d), &(x, y)| (a.min(x), b.max(x), c.min(y), d.max(y)),
+        )
+    };
+    let mut shifts = Vec::with_capacity(pieces.len());
+    let (mut x, mut top) = (0.0, 1.0_f64);
+    for p in pieces {
+        let (x0, x1, y0, y1) = bounds(p);
+        shifts.push((x - x0, -y0));
+        x += x1 - x0 + GAP;
+        top = top.max(y1 - y0);
+    }
+    let width = (x - GAP).max(1.0);
+    let (w_px, margin) = (1600_u32, 60.0);
+    let scale = (f64::from(w_px) - 2.0 * margin) / width;
+    let h_px = (top * scale + 2.0 * margin + 40.0).clamp(300.0, 1600.0) as u32;
+    let root = BitMapBackend::new(file, (w_px, h_px)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (x_lo, y_lo) = (-margin / scale, -(margin + 30.0) / scale);
+    let (x_hi, y_hi) = (
+        x_lo + f64::from(w_px) / scale,
+        y_lo + f64::from(h_px - 30) / scale,
+    );
+    let mut c = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)?;
+    let grey = RGBColor(190, 190, 190);
+    let purple = RGBColor(150, 60, 170);
+    let green = RGBColor(0, 140, 60);
+    for (p, &(dx, dy)) in pieces.iter().zip(&shifts) {
+        let at = |q: (f64, f64)| (q.0 + dx, q.1 + dy);
+        for e in &p.grid {
+            c.draw_series(std::iter::once(PathElement::new(
+                vec![at(e[0]), at(e[1])],
+                grey.stroke_width(1),
+            )))?;
+        }
+        for l in &p.lines {
+            c.draw_series(DashedLineSeries::new(
+                l.iter().map(|&q| at(q)),
+                6,
+                4,
+                grey.stroke_width(2),
+            ))?;
+        }
+        for d in &p.darts {
+            c.draw_series(std::iter::once(PathElement::new(
+                d.iter().map(|&q| at(q)).collect::<Vec<_>>(),
+                purple.stroke_width(2),
+            )))?;
+        }
+        let mut ring: Vec<(f64, f64)> = p.outline.iter().map(|&q| at(q)).collect();
+        ring.extend(ring.first().copied());
+        c.draw_series(std::iter::once(PathElement::new(
+            ring,
+            BLACK.stroke_width(2),
+        )))?;
+        if let Some([a, b]) = p.grain {
+            let (a, b) = (at(a), at(b));
+            let (ux, uy) = (b.0 - a.0, b.1 - a.1);
+            let len = ux.hypot(uy).max(1e-9);
+            let (ux, uy) = (ux / len, uy / len);
+            let head = 1.5;
+            let wing = |s: f64| {
+                (
+                    b.0 - head * ux - s * head * 0.5 * uy,
+                    b.1 - head * uy + s * head * 0.5 * ux,
+                )
+            };
+            c.draw_series(std::iter::once(PathElement::new(
+                vec![a, b],
+                green.stroke_width(3),
+            )))?;
+            c.draw_series(std::iter::once(PathElement::new(
+                vec![wing(1.0), b, wing(-1.0)],
+                green.stroke_width(3),
+            )))?;
+        }
+        c.draw_series(
+            p.notches
+                .iter()
+                .map(|&q| Circle::new(at(q), 4, RED.filled())),
+        )?;
+        c.draw_series(p.corners.iter().map(|&q| {
+            let (x, y) = at(q);
+            let h = 5.0 / scale;
+            Rectangle::new([(x - h, y - h), (x + h, y + h)], BLUE.stroke_width(2))
+        }))?;
+        let (x0, x1, _, _) = bounds(p);
+        c.draw_series(std::iter::once(Text::new(
+            p.name.clone(),
+            (
+                0.5 * (x0 + x1) + dx - 0.25 * p.name.len() as f64 * 14.0 / scale,
+                -20.0 / scale,
+            ),
+            ("sans-serif", 16),
+        )))?;
+    }
+    root.present()?;
+    Ok(())
+}

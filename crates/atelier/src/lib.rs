@@ -10,6 +10,8 @@
 //! - Scenario files ([`scenario`]) and their runs ([`run`]): the report ([`report`], with
 //!   [`convergence`]), exports ([`export`]: OBJ, PLY, glTF) and pictures ([`picture`], the one
 //!   rasteriser; [`camera`]; [`chart`], drawn only with the `charts` feature).
+//! - Patterns from pattern software and apparel CAD ([`patterns`]: DXF-AAMA read by
+//!   `atelier-import`, each piece made a pattern and gridded, written as RON and OBJ).
 //! - Virtual tests and the other scene kinds run through the same runner: wet cloth ([`wet`]),
 //!   string identification and the writing of a fabric's bending fit ([`fit`]; the fits
 //!   themselves, and the turned strip, are `atelier-fit`'s).
@@ -25,6 +27,7 @@ pub mod convergence;
 pub mod export;
 pub mod fit;
 pub mod outcome;
+pub mod patterns;
 pub mod picture;
 pub mod pipeline;
 pub mod place;

@@ -4,6 +4,8 @@
 //!   the 9AR mannequin, then a short walk — into `./atelier-out`.
 //! - `atelier run SCENARIO.ron --out DIR [--threads N] [--frames K]`: run a scenario file.
 //! - `atelier validate FILE…`: check data files.
+//! - `atelier pattern FILE.dxf --out DIR [--cell CM]`: pattern pieces from pattern software or
+//!   apparel CAD as atelier patterns, grids and a picture.
 //! - `atelier tryon --photo P.png [--mask M.png] --garment G.ron [--pose S.ron] --out DIR`:
 //!   virtual try-on from one photograph.
 //!
@@ -105,6 +107,19 @@ enum Command {
         #[command(flatten)]
         options: Options,
     },
+    /// Read a pattern file from pattern software or apparel CAD (DXF-AAMA / ASTM D6673): print
+    /// one line per piece (size, area, grain angle, notches, darts, teams, grid) and write each
+    /// piece as an atelier pattern (NAME.ron) and its grid (NAME.obj), and pieces.png, in DIR.
+    Pattern {
+        /// The pattern file (.dxf).
+        file: PathBuf,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Target grid cell size, cm.
+        #[arg(long, default_value_t = 2.0)]
+        cell: f64,
+    },
     /// Check fabric, pattern, garment, body, motion, range side, scenario and try-on pose files (RON) and
     /// body meshes (OBJ, PLY); print each problem with file:line:column and field.
     Validate {
@@ -174,6 +189,7 @@ fn main() -> ExitCode {
             }
         },
         Some(Command::Validate { files }) => validate(&files),
+        Some(Command::Pattern { file, out, cell }) => pattern(&file, &out, cell),
         Some(Command::Tryon {
             photo,
             mask,
@@ -421,4 +437,67 @@ fn validate(files: &[PathBuf]) -> ExitCode {
     } else {
         ExitCode::SUCCESS
     }
+}
+
+fn pattern(file: &Path, out: &Path, cell: f64) -> ExitCode {
+    let options = atelier_import::PanelOptions {
+        spacing_cm: cell,
+        ..atelier_import::PanelOptions::default()
+    };
+    let imported = match atelier::patterns::import(file, &options) {
+        Ok(i) => i,
+        Err(e) => {
+            eprintln!("atelier: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    for w in &imported.warnings {
+        eprintln!("warning: {w}");
+    }
+    // The pieces are the program's output.
+    #[allow(clippy::print_stdout)]
+    for p in &imported.pieces {
+        let [w, h] = p.piece.size_cm();
+        let q = (&p.panel.quality_before, &p.panel.quality_after);
+        println!(
+            "{}: {w:.1} × {h:.1} cm, {:.1} cm², grain {:.1}°, {} notches, {} darts, {} teams, quantity {}; grid {} nodes, shear SD {:.1}° → {:.1}° ({})",
+            p.piece.name,
+            p.piece.area_cm2(),
+            p.piece.grain_deg(),
+            p.piece.notches.len(),
+            p.piece.darts.len(),
+            p.plan.breakpoints.len(),
+            p.piece.quantity,
+            p.panel.topology.node_count(),
+            q.0.shear_deg.sd,
+            q.1.shear_deg.sd,
+            p.piece.outline_source
+        );
+    }
+    let written = match atelier::patterns::write_pieces(&imported, out) {
+        Ok(w) => w,
+        Err(e) => {
+            eprintln!("atelier: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let picture = out.join("pieces.png");
+    let title = format!(
+        "{} — seam lines, grids, grain (green), notches (red), grid corners (blue), darts (purple)",
+        file.file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned())
+    );
+    if let Err(e) =
+        atelier::chart::write_pieces(&picture, &title, &atelier::patterns::drawings(&imported))
+    {
+        eprintln!("atelier: {}: {e}", picture.display());
+        return ExitCode::FAILURE;
+    }
+    eprintln!(
+        "wrote {} files and {} in {}",
+        written.len(),
+        picture.display(),
+        out.display()
+    );
+    ExitCode::SUCCESS
 }

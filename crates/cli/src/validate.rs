@@ -1,6 +1,7 @@
 //! `atelier validate FILE…`: check atelier's data files — fabrics, patterns, garments, body
-//! descriptions, motions, range-image side files, scenarios, try-on poses (RON) and external
-//! bodies (OBJ, PLY) — and report each problem with file:line:column and field.
+//! descriptions, motions, range-image side files, scenarios, try-on poses (RON), external
+//! bodies (OBJ, PLY) and DXF-AAMA pattern files — and report each problem with
+//! file:line:column and field (for a DXF file: the piece and the entity).
 //!
 //! A RON file's kind is found by trying each format: the first that reads it names it; when none
 //! does, the error reported is the one that got furthest into the file (the format the file most
@@ -31,6 +32,9 @@ pub enum Kind {
     Scenario,
     /// A try-on pose (`atelier tryon --pose`, `fitted_pose.ron`).
     TryonPose,
+    /// A pattern file from pattern software or CAD (DXF-AAMA): read, each piece planned and
+    /// gridded.
+    DxfPattern,
 }
 
 impl Kind {
@@ -46,6 +50,7 @@ impl Kind {
             Kind::Mesh => "mesh",
             Kind::Scenario => "scenario",
             Kind::TryonPose => "try-on pose",
+            Kind::DxfPattern => "DXF pattern",
         }
     }
 }
@@ -65,6 +70,30 @@ pub fn validate(path: &Path) -> Outcome {
         return atelier_body::io::load_mesh(path)
             .map(|_| Kind::Mesh)
             .map_err(|e| (Some(Kind::Mesh), e));
+    }
+    if ext == "dxf" {
+        return atelier::patterns::import(path, &atelier_import::PanelOptions::default())
+            .map(|_| Kind::DxfPattern)
+            .map_err(|e| {
+                let full = e.to_string();
+                let prefix = format!("{}: ", path.display());
+                let message = full.strip_prefix(&prefix).unwrap_or(&full).to_owned();
+                let kind = match &e {
+                    atelier::patterns::PatternError::Import(
+                        atelier_import::ImportError::Read { .. },
+                    ) => atelier_fabric::ErrorKind::Io,
+                    _ => atelier_fabric::ErrorKind::Inconsistent,
+                };
+                let error = FileError {
+                    file: path.to_path_buf(),
+                    position: None,
+                    field: String::new(),
+                    kind,
+                    message,
+                    source: None,
+                };
+                (Some(Kind::DxfPattern), error)
+            });
     }
     // Unreadable files: one error, no guessing.
     if let Err(e) = std::fs::metadata(path) {
