@@ -183,6 +183,16 @@ proptest! {
     }
 
     #[test]
+    fn dxf_pattern_files(edits in prop::collection::vec(edit(), 1..6), which in 0usize..3) {
+        let base = fixture(["fixtures/patterns/dxf/bad/unknown_entities.dxf",
+            "fixtures/patterns/dxf/bad/two_pieces_same_name.dxf",
+            "fixtures/patterns/dxf/bad/open_outline.dxf"][which]);
+        let text = mutate(&base, &edits);
+        let t = text.clone();
+        guarded("the DXF pattern reader and gridder", &text, move || load_dxf_pattern(t));
+    }
+
+    #[test]
     fn garment_files(edits in prop::collection::vec(edit(), 1..6)) {
         let text = mutate(&fixture("fixtures/patterns/dress/skirt.ron"), &edits);
         let t = text.clone();
@@ -268,6 +278,7 @@ proptest! {
             ("observations", Box::new(load_observations)),
             ("scenario", Box::new(load_scenario)),
             ("mesh", Box::new(load_mesh)),
+            ("DXF pattern", Box::new(load_dxf_pattern)),
             ("cloth observations", Box::new(load_cloth_observations)),
         ] {
             let t = text.clone();

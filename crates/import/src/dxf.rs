@@ -43,10 +43,7 @@ pub struct Import {
 /// Read a DXF-AAMA file.
 pub fn read(path: &Path) -> Result<Import, ImportError> {
     let file = path.to_path_buf();
-    let drawing = Drawing::load_file(path).map_err(|e| ImportError::Read {
-        file: file.clone(),
-        message: e.to_string(),
-    })?;
+    let drawing = load(path)?;
     let mut warnings = Vec::new();
     let texts: Vec<String> = drawing
         .entities()
@@ -104,6 +101,34 @@ pub fn read(path: &Path) -> Result<Import, ImportError> {
         warnings,
         cm_per_unit,
         style,
+    })
+}
+
+/// The drawing, read by the `dxf` crate. The crate panics on some hostile values (a header date
+/// far out of range: `DateTime + TimeDelta overflowed`, found by the hostile-input tests); such a
+/// panic is caught here, its message kept, and the file reported as unreadable. The panic hook
+/// is silenced for the call so that the program's one-line error is all the user sees.
+fn load(path: &Path) -> Result<Drawing, ImportError> {
+    let read = || Drawing::load_file(path);
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let outcome = std::panic::catch_unwind(read);
+    std::panic::set_hook(previous);
+    let message = match outcome {
+        Ok(Ok(drawing)) => return Ok(drawing),
+        Ok(Err(e)) => e.to_string(),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_owned())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            format!("the DXF reader failed on this file ({what})")
+        }
+    };
+    Err(ImportError::Read {
+        file: path.to_path_buf(),
+        message,
     })
 }
 

@@ -266,23 +266,17 @@ fn orient(piece: &Piece, four: [usize; 4]) -> [usize; 4] {
 /// A piece's pattern and grid. With corners given, that plan; without, every set of
 /// [`corner_candidates`] among the six vertices that turn most is planned and gridded, and
 /// the grid with the least shear spread after improvement is kept (a set whose teams a dart
-/// or the gridder cannot use is passed over). Where darts' wedges run into each other in the
-/// grid, their legs are given fewer cells (× 0.75, 0.5, 0.35) before a set is passed over. The
-/// error is the first candidate's when none grids.
+/// or the gridder cannot use is passed over). Either way, where a dart's wedge runs into
+/// another in the grid, its legs are given fewer cells (`grid_shortening_darts`). The error
+/// is the first candidate's when none grids.
 pub fn plan_and_grid(
     piece: &Piece,
     options: &PanelOptions,
     provenance: &str,
     params: ImproveParams,
 ) -> Result<(Plan, Panel), PieceProblem> {
-    let grid = |o: &PanelOptions| -> Result<(Plan, Panel), PieceProblem> {
-        let p = plan(piece, o, provenance)?;
-        let panel = grid_pattern(&p.spec, params)
-            .map_err(|e| PieceProblem::Sides(format!("cannot grid it: {e}")))?;
-        Ok((p, panel))
-    };
-    if options.corners.is_some() {
-        return grid(options);
+    if let Some(corners) = options.corners {
+        return grid_shortening_darts(piece, options, corners, provenance, params);
     }
     let mut first_error = None;
     let mut best: Option<(Plan, Panel)> = None;

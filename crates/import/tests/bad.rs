@@ -134,3 +134,22 @@ fn a_missing_or_non_dxf_file_is_an_error_not_a_panic() {
     let text = Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml");
     assert!(dxf::read(&text).is_err());
 }
+
+/// A header date far out of range made the `dxf` crate panic (`DateTime + TimeDelta
+/// overflowed`, found by the hostile-input tests): the reader reports the file as unreadable.
+#[test]
+fn a_date_out_of_range_is_an_error_not_a_panic() {
+    let text = std::fs::read_to_string(bad("unknown_entities.dxf")).expect("fixture");
+    let hostile = text.replacen("$TDCREATE\n 40\n2451545.0", "$TDCREATE\n 40\n1e308", 1);
+    assert_ne!(hostile, text, "the fixture holds $TDCREATE");
+    let dir = std::env::temp_dir().join(format!("atelier-import-date-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("date.dxf");
+    std::fs::write(&path, hostile).expect("write");
+    let e = dxf::read(&path).expect_err("refused");
+    assert!(
+        matches!(&e, ImportError::Read { message, .. } if message.contains("failed on this file")),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

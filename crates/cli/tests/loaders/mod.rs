@@ -54,6 +54,20 @@ pub fn load_pattern(text: String) {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A DXF-AAMA pattern file: read, every piece planned (corners searched) and gridded, as
+/// `atelier pattern` does (4 cm cells, to keep a case short).
+pub fn load_dxf_pattern(text: String) {
+    let dir = scratch("dxf");
+    let path = dir.join("p.dxf");
+    std::fs::write(&path, &text).expect("write");
+    let options = atelier_import::PanelOptions {
+        spacing_cm: 4.0,
+        ..atelier_import::PanelOptions::default()
+    };
+    let _ = atelier::patterns::import(&path, &options);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A garment file beside the skirt's patterns: read, grid every panel, pair the seams.
 pub fn load_garment(text: String) {
     let dir = scratch("garment");
