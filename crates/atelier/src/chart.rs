@@ -62,14 +62,23 @@ const COLOURS: [RGBColor; 3] = [
 /// Draw `chart` into a PNG of `size` pixels at `path` (a temporary file beside it, renamed when
 /// complete).
 pub fn write_chart(path: &Path, chart: &Chart, size: (u32, u32)) -> std::io::Result<()> {
+    write_png(path, |tmp| draw(tmp, chart, size))
+}
+
+#[cfg(feature = "charts")]
+/// Draw with `draw` into a temporary file beside `path` (the bundled font registered first),
+/// renamed to `path` when complete and removed when drawing fails.
+fn write_png(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> Result<(), Box<dyn std::error::Error + Send + Sync>>,
+) -> std::io::Result<()> {
     if !font() {
         return Err(std::io::Error::other(
             "the bundled font could not be loaded",
         ));
     }
     let tmp = atelier_files::files::temporary_sibling(path);
-    let drawn = draw(&tmp, chart, size);
-    match drawn {
+    match draw(&tmp) {
         Ok(()) => std::fs::rename(&tmp, path),
         Err(e) => {
             let _ = std::fs::remove_file(&tmp);
@@ -179,19 +188,7 @@ pub struct PieceDrawing {
 /// squares, darts purple, internal lines dashed grey; each piece's name under it. Written
 /// atomically.
 pub fn write_pieces(path: &Path, title: &str, pieces: &[PieceDrawing]) -> std::io::Result<()> {
-    if !font() {
-        return Err(std::io::Error::other(
-            "the bundled font could not be loaded",
-        ));
-    }
-    let tmp = atelier_files::files::temporary_sibling(path);
-    match draw_pieces(&tmp, title, pieces) {
-        Ok(()) => std::fs::rename(&tmp, path),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(std::io::Error::other(e))
-        }
-    }
+    write_png(path, |tmp| draw_pieces(tmp, title, pieces))
 }
 
 #[cfg(feature = "charts")]
