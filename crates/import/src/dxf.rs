@@ -189,13 +189,31 @@ fn describe(e: &Entity) -> String {
 }
 
 fn type_name(t: &EntityType) -> String {
-    let debug = format!("{t:?}");
-    let name = debug.split('(').next().unwrap_or("entity");
-    match name {
-        "LwPolyline" => "LWPOLYLINE".into(),
-        "ModelPoint" => "POINT".into(),
-        other => other.to_ascii_uppercase(),
+    let known = match t {
+        EntityType::Line(_) => "LINE",
+        EntityType::LwPolyline(_) => "LWPOLYLINE",
+        EntityType::Polyline(_) => "POLYLINE",
+        EntityType::ModelPoint(_) => "POINT",
+        EntityType::Text(_) => "TEXT",
+        EntityType::MText(_) => "MTEXT",
+        EntityType::Circle(_) => "CIRCLE",
+        EntityType::Arc(_) => "ARC",
+        EntityType::Ellipse(_) => "ELLIPSE",
+        EntityType::Spline(_) => "SPLINE",
+        EntityType::Insert(_) => "INSERT",
+        EntityType::Solid(_) => "SOLID",
+        _ => "",
+    };
+    if !known.is_empty() {
+        return known.to_owned();
     }
+    // Any other type: its variant's name, from the debug form (rare, so its cost is no matter).
+    let debug = format!("{t:?}");
+    debug
+        .split('(')
+        .next()
+        .unwrap_or("entity")
+        .to_ascii_uppercase()
 }
 
 /// The points of a polyline entity in file units, arcs (bulges) flattened; and its closed flag.
