@@ -57,9 +57,9 @@ pub enum PatternError {
     },
 }
 
-/// Read a pattern file (`.dxf`) and grid every piece.
+/// Read a pattern file (`.dxf` DXF-AAMA, `.svg` FreeSewing) and grid every piece.
 pub fn import(file: &Path, options: &PanelOptions) -> Result<Imported, PatternError> {
-    let read = atelier_import::dxf::read(file)?;
+    let read = atelier_import::read(file)?;
     let provenance = format!("imported from {}", file.display());
     let mut pieces = Vec::with_capacity(read.pieces.len());
     for piece in read.pieces {

@@ -4,7 +4,7 @@
 //!   the 9AR mannequin, then a short walk — into `./atelier-out`.
 //! - `atelier run SCENARIO.ron --out DIR [--threads N] [--frames K]`: run a scenario file.
 //! - `atelier validate FILE…`: check data files.
-//! - `atelier pattern FILE.dxf --out DIR [--cell CM]`: pattern pieces from pattern software or
+//! - `atelier pattern FILE.dxf|FILE.svg --out DIR [--cell CM]`: pattern pieces from pattern software or
 //!   apparel CAD as atelier patterns, grids and a picture.
 //! - `atelier tryon --photo P.png [--mask M.png] --garment G.ron [--pose S.ron] --out DIR`:
 //!   virtual try-on from one photograph.
@@ -107,11 +107,12 @@ enum Command {
         #[command(flatten)]
         options: Options,
     },
-    /// Read a pattern file from pattern software or apparel CAD (DXF-AAMA / ASTM D6673): print
+    /// Read a pattern file from pattern software or apparel CAD (DXF-AAMA / ASTM D6673, FreeSewing
+    /// SVG): print
     /// one line per piece (size, area, grain angle, notches, darts, teams, grid) and write each
     /// piece as an atelier pattern (NAME.ron) and its grid (NAME.obj), and pieces.png, in DIR.
     Pattern {
-        /// The pattern file (.dxf).
+        /// The pattern file: DXF-AAMA (.dxf) or FreeSewing SVG (.svg).
         file: PathBuf,
         /// Output folder (created if missing).
         #[arg(long)]

@@ -32,8 +32,8 @@ pub enum Kind {
     Scenario,
     /// A try-on pose (`atelier tryon --pose`, `fitted_pose.ron`).
     TryonPose,
-    /// A pattern file from pattern software or CAD (DXF-AAMA): read, each piece planned and
-    /// gridded.
+    /// A pattern file from pattern software or CAD (DXF-AAMA, FreeSewing SVG): read, each piece
+    /// planned and gridded.
     DxfPattern,
 }
 
@@ -50,7 +50,7 @@ impl Kind {
             Kind::Mesh => "mesh",
             Kind::Scenario => "scenario",
             Kind::TryonPose => "try-on pose",
-            Kind::DxfPattern => "DXF pattern",
+            Kind::DxfPattern => "pattern file (DXF-AAMA or FreeSewing SVG)",
         }
     }
 }
@@ -71,7 +71,7 @@ pub fn validate(path: &Path) -> Outcome {
             .map(|_| Kind::Mesh)
             .map_err(|e| (Some(Kind::Mesh), e));
     }
-    if ext == "dxf" {
+    if ext == "dxf" || ext == "svg" {
         return atelier::patterns::import(path, &atelier_import::PanelOptions::default())
             .map(|_| Kind::DxfPattern)
             .map_err(|e| {

@@ -193,6 +193,13 @@ proptest! {
     }
 
     #[test]
+    fn svg_pattern_files(edits in prop::collection::vec(edit(), 1..6)) {
+        let text = mutate(SVG, &edits);
+        let t = text.clone();
+        guarded("the SVG pattern reader and gridder", &text, move || load_svg_pattern(t));
+    }
+
+    #[test]
     fn garment_files(edits in prop::collection::vec(edit(), 1..6)) {
         let text = mutate(&fixture("fixtures/patterns/dress/skirt.ron"), &edits);
         let t = text.clone();
@@ -279,6 +286,7 @@ proptest! {
             ("scenario", Box::new(load_scenario)),
             ("mesh", Box::new(load_mesh)),
             ("DXF pattern", Box::new(load_dxf_pattern)),
+            ("SVG pattern", Box::new(load_svg_pattern)),
             ("cloth observations", Box::new(load_cloth_observations)),
         ] {
             let t = text.clone();

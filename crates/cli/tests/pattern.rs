@@ -91,7 +91,7 @@ fn validate_reads_dxf_patterns_and_names_the_piece_and_entity_of_a_bad_one() {
     assert_eq!(code, Some(1));
     let lines: Vec<&str> = stdout.lines().collect();
     assert!(
-        lines[0].starts_with("ok") && lines[0].contains("DXF pattern"),
+        lines[0].starts_with("ok") && lines[0].contains("pattern file"),
         "{stdout}"
     );
     assert!(lines[1].starts_with("error"), "{stdout}");
@@ -126,4 +126,34 @@ fn a_bad_pattern_file_fails_with_one_line_and_writes_nothing() {
     let (code, _, stderr) = atelier(&["pattern", missing.to_str().expect("utf-8"), "--out", "x"]);
     assert_eq!(code, Some(1));
     assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+/// FreeSewing's Penelope pencil skirt (SVG): three pieces, the front and the waistband unfolded
+/// from their halves, the waist darts closed, each gridded and written.
+#[test]
+fn the_freesewing_skirt_is_read_and_gridded() {
+    let out = temp_dir("penelope");
+    let (code, stdout, stderr) = atelier(&[
+        "pattern",
+        "fixtures/patterns/freesewing/penelope.svg",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 3, "{stdout}");
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("penelope.front:") && l.contains("4 darts")),
+        "{stdout}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("penelope.back:") && l.contains("2 darts")),
+        "{stdout}"
+    );
+    assert!(out.join("penelope_front.ron").is_file() && out.join("pieces.png").is_file());
+    std::fs::remove_dir_all(&out).ok();
 }

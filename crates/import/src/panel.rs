@@ -302,9 +302,10 @@ pub fn plan_and_grid(
 }
 
 /// Plan and grid with the given corners; when a dart's wedge runs into another constraint in
-/// the grid (two darts whose apexes lie close: the bodice's waist and bust darts), that dart's
-/// legs get one cell fewer (its apex then sits nearer its opening in the grid), until it fits or
-/// has one cell. Leg counts given in `options` are never changed.
+/// the grid (two darts whose apexes lie close: the bodice's waist and bust darts) or its legs
+/// are longer than the grid is across, that dart's legs get one cell fewer (its apex then sits
+/// nearer its opening in the grid), until it fits or has one cell. Leg counts given in
+/// `options` are never changed.
 fn grid_shortening_darts(
     piece: &Piece,
     options: &PanelOptions,
@@ -329,7 +330,10 @@ fn grid_shortening_darts(
             .strip_prefix("darts[")
             .and_then(|r| r.split(']').next())
             .and_then(|k| k.parse::<usize>().ok())
-            .filter(|_| options.dart_cells.is_none() && e.message.contains("overlaps"));
+            .filter(|_| {
+                options.dart_cells.is_none()
+                    && (e.message.contains("overlaps") || e.message.contains("they need"))
+            });
         let mut cells: Vec<usize> = p.spec.darts.iter().map(|d| d.cells).collect();
         match overlapping {
             Some(k) if cells.get(k).is_some_and(|&c| c > 1) => {

@@ -146,6 +146,74 @@ impl Piece {
         Some(at)
     }
 
+    /// Darts drawn as V notches in the outline itself (FreeSewing's way): a vertex where the
+    /// counter-clockwise outline turns clockwise by more than `tip_deg` (a reflex inside angle
+    /// sharper than 180° − `tip_deg`) is a dart's tip; walking from it
+    /// both ways along the legs to the first vertex that turns by more than `leg_deg` finds
+    /// the opening's ends. The legs and the tip leave the outline, which now runs straight
+    /// across the opening, and become a [`Dart`] (its legs straight, as the gridder makes
+    /// them: a curved leg is straightened). Returns how many were closed. Call it before
+    /// turns and notches are set (it renumbers the outline).
+    pub fn close_v_darts(&mut self, tip_deg: f64, leg_deg: f64) -> usize {
+        // Each dart as points (opening ends, apex): indices move as vertices leave.
+        let mut found: Vec<([f64; 2], [f64; 2], [f64; 2])> = Vec::new();
+        loop {
+            let n = self.outline.len();
+            if n < 6 {
+                break;
+            }
+            // A tip turns the outline back clockwise (the piece's inside angle there is
+            // reflex); a convex corner turns it counter-clockwise.
+            let Some(tip) = (0..n).find(|&k| self.turning_deg(k) < -tip_deg) else {
+                break;
+            };
+            let walk = |step: usize| {
+                let mut k = tip;
+                for _ in 0..n {
+                    k = (k + step) % n;
+                    if self.turning_deg(k).abs() > leg_deg {
+                        return Some(k);
+                    }
+                }
+                None
+            };
+            let (Some(from), Some(to)) = (walk(n - 1), walk(1)) else {
+                break;
+            };
+            if from == to {
+                break;
+            }
+            // Keep everything outside the V, from `to` round to `from`.
+            let mut kept = Vec::with_capacity(n);
+            let mut k = to;
+            loop {
+                kept.push(self.outline[k]);
+                if k == from {
+                    break;
+                }
+                k = (k + 1) % n;
+            }
+            if kept.len() < 3 || self_intersection(&kept).is_some() {
+                break;
+            }
+            found.push((self.outline[from], self.outline[to], self.outline[tip]));
+            self.outline = kept;
+        }
+        let at = |outline: &[[f64; 2]], p: [f64; 2]| {
+            outline.iter().position(|&q| dist(q, p) < SAME_POINT_CM)
+        };
+        for (a, b, apex) in &found {
+            if let (Some(from), Some(to)) = (at(&self.outline, *a), at(&self.outline, *b)) {
+                self.darts.push(Dart {
+                    from,
+                    to,
+                    apex: *apex,
+                });
+            }
+        }
+        found.len()
+    }
+
     /// Whether `p` lies inside the outline.
     pub fn contains(&self, p: [f64; 2]) -> bool {
         contains(&self.outline, p)

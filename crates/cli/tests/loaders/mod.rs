@@ -68,6 +68,24 @@ pub fn load_dxf_pattern(text: String) {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A FreeSewing-style SVG pattern file: read, every part unfolded, its V darts closed,
+/// planned (corners searched) and gridded, as `atelier pattern` does (4 cm cells).
+pub fn load_svg_pattern(text: String) {
+    let dir = scratch("svg");
+    let path = dir.join("p.svg");
+    std::fs::write(&path, &text).expect("write");
+    let options = atelier_import::PanelOptions {
+        spacing_cm: 4.0,
+        ..atelier_import::PanelOptions::default()
+    };
+    let _ = atelier::patterns::import(&path, &options);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A small FreeSewing-style SVG: one part cut on the fold, with a V dart, a grain line and a
+/// notch (the layout of `fixtures/patterns/freesewing/`).
+pub const SVG: &str = r##"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="300mm" height="400mm" viewBox="0 0 300 400"><defs><g id="notch"><circle r="1"/></g></defs><g id="fs-container"><g id="fs-stack-x.front" transform="translate(20, 10)"><g id="fs-stack-x.front-part-x.front" transform="translate(0, 0)"><path class="fabric" d="M 0,0 L 0,300 L 200,300 C 210,200 210,100 200,0 L 120,0 L 110,80 L 100,0 z"/><path class="fabric sa" d="M -10,-10 L -10,310 L 210,310 L 210,-10 z"/><path class="note" marker-start="url(#cutonfoldFrom)" marker-end="url(#cutonfoldTo)" data-text="cutOnFoldAndGrainline" d="M 0,20 L 15,20 L 15,280 L 0,280"/><use x="200" y="150" xlink:href="#notch"/><text class="text-lg fill-current font-bold">front</text></g></g></g></svg>"##;
+
 /// A garment file beside the skirt's patterns: read, grid every panel, pair the seams.
 pub fn load_garment(text: String) {
     let dir = scratch("garment");
