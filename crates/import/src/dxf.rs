@@ -40,6 +40,41 @@ pub struct Import {
     pub style: Option<String>,
 }
 
+impl Import {
+    /// The import of `named` pieces (each with the block or group it came from): refused when
+    /// two share a name (seams will name pieces) or when there are none.
+    pub(crate) fn collect(
+        file: &Path,
+        named: Vec<(Piece, String)>,
+        warnings: Vec<String>,
+        cm_per_unit: f64,
+        style: Option<String>,
+    ) -> Result<Self, ImportError> {
+        for (k, (piece, source)) in named.iter().enumerate() {
+            if let Some((_, first)) = named[..k].iter().find(|(p, _)| p.name == piece.name) {
+                return Err(ImportError::DuplicateName {
+                    file: file.to_path_buf(),
+                    name: piece.name.clone(),
+                    first: first.clone(),
+                    second: source.clone(),
+                });
+            }
+        }
+        if named.is_empty() {
+            return Err(ImportError::NoPieces {
+                file: file.to_path_buf(),
+                skipped: warnings,
+            });
+        }
+        Ok(Self {
+            pieces: named.into_iter().map(|(p, _)| p).collect(),
+            warnings,
+            cm_per_unit,
+            style,
+        })
+    }
+}
+
 /// Read a DXF-AAMA file.
 pub fn read(path: &Path) -> Result<Import, ImportError> {
     let file = path.to_path_buf();
@@ -58,14 +93,6 @@ pub fn read(path: &Path) -> Result<Import, ImportError> {
             continue; // *Model_Space, *Paper_Space
         }
         if let Some(piece) = read_block(block, cm_per_unit, &file, &mut warnings)? {
-            if let Some((_, first)) = pieces.iter().find(|(p, _)| p.name == piece.name) {
-                return Err(ImportError::DuplicateName {
-                    file,
-                    name: piece.name,
-                    first: first.clone(),
-                    second: block.name.clone(),
-                });
-            }
             pieces.push((piece, block.name.clone()));
         }
     }
@@ -90,18 +117,7 @@ pub fn read(path: &Path) -> Result<Import, ImportError> {
         }
     }
     warnings.extend(unsupported_entities(path));
-    if pieces.is_empty() {
-        return Err(ImportError::NoPieces {
-            file,
-            skipped: warnings,
-        });
-    }
-    Ok(Import {
-        pieces: pieces.into_iter().map(|(p, _)| p).collect(),
-        warnings,
-        cm_per_unit,
-        style,
-    })
+    Import::collect(&file, pieces, warnings, cm_per_unit, style)
 }
 
 /// The drawing, read by the `dxf` crate. The crate panics on some hostile values (a header date

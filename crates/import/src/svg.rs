@@ -81,31 +81,13 @@ pub fn read_with(path: &Path, close_darts: bool) -> Result<Import, ImportError> 
                 problem,
             },
         )?;
-        if let Some((_, first)) = pieces.iter().find(|(p, _)| p.name == piece.name) {
-            return Err(ImportError::DuplicateName {
-                file,
-                name: piece.name,
-                first: first.clone(),
-                second: id.to_owned(),
-            });
-        }
         pieces.push((piece, id.to_owned()));
     }
-    if pieces.is_empty() {
-        return Err(ImportError::NoPieces {
-            file,
-            skipped: warnings,
-        });
-    }
-    Ok(Import {
-        pieces: pieces.into_iter().map(|(p, _)| p).collect(),
-        warnings,
-        cm_per_unit: cm,
-        style: root
-            .attribute(("http://freesewing.org/namespaces/freesewing", "freesewing"))
-            .or_else(|| root.attribute("freesewing"))
-            .map(|v| format!("FreeSewing {v}")),
-    })
+    let style = root
+        .attribute(("http://freesewing.org/namespaces/freesewing", "freesewing"))
+        .or_else(|| root.attribute("freesewing"))
+        .map(|v| format!("FreeSewing {v}"));
+    Import::collect(&file, pieces, warnings, cm, style)
 }
 
 /// Centimetres per user unit: the root's width with its unit over the viewBox's width.

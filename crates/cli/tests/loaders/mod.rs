@@ -57,23 +57,20 @@ pub fn load_pattern(text: String) {
 /// A DXF-AAMA pattern file: read, every piece planned (corners searched) and gridded, as
 /// `atelier pattern` does (4 cm cells, to keep a case short).
 pub fn load_dxf_pattern(text: String) {
-    let dir = scratch("dxf");
-    let path = dir.join("p.dxf");
-    std::fs::write(&path, &text).expect("write");
-    let options = atelier_import::PanelOptions {
-        spacing_cm: 4.0,
-        ..atelier_import::PanelOptions::default()
-    };
-    let _ = atelier::patterns::import(&path, &options);
-    std::fs::remove_dir_all(&dir).ok();
+    load_imported(&text, "dxf");
 }
 
 /// A FreeSewing-style SVG pattern file: read, every part unfolded, its V darts closed,
 /// planned (corners searched) and gridded, as `atelier pattern` does (4 cm cells).
 pub fn load_svg_pattern(text: String) {
-    let dir = scratch("svg");
-    let path = dir.join("p.svg");
-    std::fs::write(&path, &text).expect("write");
+    load_imported(&text, "svg");
+}
+
+/// A pattern file of extension `ext` through `atelier::patterns::import` at 4 cm cells.
+fn load_imported(text: &str, ext: &str) {
+    let dir = scratch(ext);
+    let path = dir.join(format!("p.{ext}"));
+    std::fs::write(&path, text).expect("write");
     let options = atelier_import::PanelOptions {
         spacing_cm: 4.0,
         ..atelier_import::PanelOptions::default()
