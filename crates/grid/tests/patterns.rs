@@ -442,3 +442,49 @@ fn a_bad_spec_built_in_code_is_an_error_not_a_panic() {
     let e = grid_pattern(&spec, bad).expect_err("NaN weight");
     assert_eq!(e.field, "improve.c2");
 }
+
+/// Largest distance (m) from a node of one set to the nearest node of the other.
+fn set_gap(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
+    let near = |p: &[f64; 2], set: &[[f64; 2]]| {
+        set.iter()
+            .map(|q| (p[0] - q[0]).hypot(p[1] - q[1]))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let ab = a.iter().map(|p| near(p, b)).fold(0.0, f64::max);
+    let ba = b.iter().map(|p| near(p, a)).fold(0.0, f64::max);
+    ab.max(ba)
+}
+
+#[test]
+fn a_mirrored_pattern_grids_as_the_drafted_mirror_half() {
+    // draft.py wrote the back skirt's left half as the mirror of the right half, with its own
+    // outline (the centre back on the right side, the side seam on the left). The right half's
+    // pattern mirrored by the gridder must give the same grid: the Coons grid to rounding, and
+    // the improved grid as far as the improvement converges (run to a relative change of 1e-13,
+    // the test of `docs/patterns-import.md`).
+    let (right, _) = grid("dress/back_skirt_right.ron");
+    let (left, _) = grid("dress/back_skirt_left.ron");
+    let mirrored = right.mirrored().expect("a quad");
+    let converged = ImproveParams {
+        relative_tolerance: 1e-13,
+        max_iterations: 100_000,
+        ..ImproveParams::default()
+    };
+    let m = grid_pattern(&mirrored, converged).unwrap_or_else(|e| panic!("{e}"));
+    let l = grid_pattern(&left, converged).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.topology.node_count(), l.topology.node_count());
+    let coons = set_gap(&m.initial.positions, &l.initial.positions);
+    assert!(coons < 1e-9, "Coons grids differ by {coons} m");
+    let improved = set_gap(m.topology.rest_positions(), l.topology.rest_positions());
+    eprintln!("mirrored back skirt: Coons grids {coons:.2e} m apart, improved {improved:.2e} m");
+    assert!(improved < 1e-5, "improved grids differ by {improved} m");
+    // Every team keeps its name and node count; the seams of skirt.ron pair the same edges.
+    for t in &m.teams {
+        let other = l
+            .teams
+            .iter()
+            .find(|u| u.name == t.name)
+            .expect("same team names");
+        assert_eq!(t.nodes.len(), other.nodes.len(), "{}", t.name);
+    }
+}
