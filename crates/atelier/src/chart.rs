@@ -180,12 +180,16 @@ pub struct PieceDrawing {
     pub darts: Vec<[(f64, f64); 3]>,
     /// Internal lines drawn only.
     pub lines: Vec<Vec<(f64, f64)>>,
+    /// The team ends in order, numbered from 0 (team `k-(k+1)` runs from `k` to `k + 1`; the
+    /// names a garment's seams use).
+    pub breakpoints: Vec<(f64, f64)>,
 }
 
 #[cfg(feature = "charts")]
 /// Draw pattern pieces side by side on one sheet, at one scale (cm on both axes): outline
 /// black, grid grey, grain line a green arrow, notches red dots, the grid's corners blue
-/// squares, darts purple, internal lines dashed grey; each piece's name under it. Written
+/// squares, darts purple, internal lines dashed grey, the team ends numbered in blue; each
+/// piece's name under it. Written
 /// atomically.
 pub fn write_pieces(path: &Path, title: &str, pieces: &[PieceDrawing]) -> std::io::Result<()> {
     write_png(path, |tmp| draw_pieces(tmp, title, pieces))
@@ -293,6 +297,22 @@ fn draw_pieces(
             let (x, y) = at(q);
             let h = 5.0 / scale;
             Rectangle::new([(x - h, y - h), (x + h, y + h)], BLUE.stroke_width(2))
+        }))?;
+        // Breakpoint numbers, set in from the outline towards the piece's centre.
+        let n = p.outline.len().max(1) as f64;
+        let centre = p
+            .outline
+            .iter()
+            .fold((0.0, 0.0), |(sx, sy), &(x, y)| (sx + x / n, sy + y / n));
+        c.draw_series(p.breakpoints.iter().enumerate().map(|(k, &q)| {
+            let (vx, vy) = (centre.0 - q.0, centre.1 - q.1);
+            let inset = 16.0 / scale / vx.hypot(vy).max(1e-9);
+            let (x, y) = at((q.0 + inset * vx, q.1 + inset * vy));
+            Text::new(
+                k.to_string(),
+                (x - 4.0 / scale, y + 6.0 / scale),
+                ("sans-serif", 13).into_font().color(&BLUE),
+            )
         }))?;
         let (x0, x1, _, _) = bounds(p);
         c.draw_series(std::iter::once(Text::new(

@@ -3,10 +3,14 @@
 //! written as one pattern RON and one grid OBJ per piece and a picture of all pieces
 //! (`docs/patterns-import.md`). Composes the importer and the gridder; computes nothing itself.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use atelier_files::{ErrorKind, FileError};
 use atelier_grid::ImproveParams;
-use atelier_grid::pattern::Panel;
+use atelier_grid::pattern::{
+    Garment, Panel, PanelPattern, PanelRef, drafted_pattern, load_garment_with,
+};
 use atelier_import::{ImportError, PanelOptions, Piece, PieceProblem, Plan, plan_and_grid};
 
 use crate::export::{ExportError, MeshPart, write_obj};
@@ -75,6 +79,90 @@ pub fn import(file: &Path, options: &PanelOptions) -> Result<Imported, PatternEr
         pieces,
         warnings: read.warnings,
     })
+}
+
+/// Read a garment file whose panels are atelier pattern files or pieces of files from pattern
+/// software (`piece: "…"` with a `.dxf` or `.svg` pattern): each imported piece planned like
+/// `atelier pattern` plans it (2 cm cells, its corners given or searched, `notches` added), its
+/// cell counts then matched across the seams by the gridder
+/// (`atelier_grid::pattern::load_garment_with`). A file is read once however many panels name
+/// its pieces; the import's warnings are not errors and are not repeated here (`atelier pattern`
+/// and `atelier validate` print them).
+pub fn load_garment(path: &Path, params: ImproveParams) -> Result<Garment, FileError> {
+    let mut files: HashMap<PathBuf, Vec<Piece>> = HashMap::new();
+    let mut resolve = |file: &Path, panel: &PanelRef| -> Result<PanelPattern, FileError> {
+        let Some(name) = &panel.piece else {
+            return drafted_pattern(file, panel);
+        };
+        let fail = |field: &str, kind: ErrorKind, message: String| FileError {
+            file: file.to_path_buf(),
+            position: None,
+            field: field.to_owned(),
+            kind,
+            message,
+            source: None,
+        };
+        if !files.contains_key(file) {
+            let read = atelier_import::read(file).map_err(|e| {
+                fail(
+                    "",
+                    ErrorKind::Inconsistent,
+                    format!("panel `{}`: {e}", panel.name),
+                )
+            })?;
+            files.insert(file.to_path_buf(), read.pieces);
+        }
+        let pieces = &files[file];
+        let mut piece = pieces
+            .iter()
+            .find(|p| p.name == *name)
+            .cloned()
+            .ok_or_else(|| {
+                let names: Vec<&str> = pieces.iter().map(|p| p.name.as_str()).collect();
+                fail(
+                    "piece",
+                    ErrorKind::Inconsistent,
+                    format!(
+                        "panel `{}`: the file has no piece named `{name}` (it has: {})",
+                        panel.name,
+                        names.join(", ")
+                    ),
+                )
+            })?;
+        for (k, &(x, y)) in panel.notches.iter().enumerate() {
+            let v = piece.vertex_at([x, y]).ok_or_else(|| {
+                fail(
+                    &format!("notches[{k}]"),
+                    ErrorKind::Inconsistent,
+                    format!(
+                        "panel `{}`: notch ({x}, {y}) cm is not on the outline of piece `{name}`",
+                        panel.name
+                    ),
+                )
+            })?;
+            if !piece.notches.contains(&v) {
+                piece.notches.push(v);
+            }
+        }
+        let options = PanelOptions {
+            corners: panel.corners.map(|c| c.map(|(x, y)| [x, y])),
+            ..PanelOptions::default()
+        };
+        let provenance = format!("piece `{name}` imported from {}", file.display());
+        let (plan, _) =
+            plan_and_grid(&piece, &options, &provenance, params).map_err(|problem| {
+                fail(
+                    "piece",
+                    ErrorKind::Inconsistent,
+                    format!("panel `{}` (piece `{name}`): {problem}", panel.name),
+                )
+            })?;
+        Ok(PanelPattern {
+            spec: plan.spec,
+            counts_free: true,
+        })
+    };
+    load_garment_with(path, params, &mut resolve)
 }
 
 /// A file name for a piece: letters and digits kept, the rest `_`.
@@ -192,6 +280,7 @@ pub fn drawings(imported: &Imported) -> Vec<crate::chart::PieceDrawing> {
                     .iter()
                     .map(|l| l.iter().copied().map(pt).collect())
                     .collect(),
+                breakpoints: p.plan.breakpoints.iter().copied().map(pt).collect(),
             }
         })
         .collect()

@@ -15,7 +15,6 @@ use atelier_fabric::{
     AnisotropyForm, ErrorKind, Fabric, FileError, InvalidValue, STANDARD_GRAVITY,
 };
 use atelier_grid::ImproveParams;
-use atelier_grid::pattern::load_garment;
 use atelier_solver::StepParams;
 use atelier_solver::baselines::{MassSpringParams, XpbdParams};
 use serde::{Deserialize, Serialize};
@@ -399,7 +398,7 @@ impl Garment {
         placements: Vec<Placement>,
         place: PlaceParams,
     ) -> Result<Self, SceneError> {
-        let pattern = load_garment(garment, ImproveParams::default())?;
+        let pattern = crate::patterns::load_garment(garment, ImproveParams::default())?;
         let fabric = Fabric::load(fabric)?;
         if placements.len() != pattern.panels.len() {
             return Err(crate::place::PlaceError::Count {

@@ -484,7 +484,7 @@ fn pattern(file: &Path, out: &Path, cell: f64) -> ExitCode {
     };
     let picture = out.join("pieces.png");
     let title = format!(
-        "{} — seam lines, grids, grain (green), notches (red), grid corners (blue), darts (purple)",
+        "{} — seam lines, grids, grain (green), notches (red), grid corners (blue), darts (purple), team ends numbered (teams k-(k+1))",
         file.file_name()
             .map_or(String::new(), |n| n.to_string_lossy().into_owned())
     );

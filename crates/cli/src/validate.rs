@@ -5,7 +5,8 @@
 //!
 //! A RON file's kind is found by trying each format: the first that reads it names it; when none
 //! does, the error reported is the one that got furthest into the file (the format the file most
-//! likely is), with that format's name.
+//! likely is), with that format's name; an error found after the file was read whole as a format
+//! (a garment whose panel does not grid, a scenario naming a missing file) goes furthest.
 
 use std::path::Path;
 
@@ -131,8 +132,7 @@ pub fn validate(path: &Path) -> Outcome {
                 .map_err(|e| FileError::from_invalid(p, e))
         }),
         (Kind::Garment, &|p| {
-            atelier_grid::pattern::load_garment(p, atelier_grid::ImproveParams::default())
-                .map(|_| ())
+            atelier::patterns::load_garment(p, atelier_grid::ImproveParams::default()).map(|_| ())
         }),
         (Kind::BodyDescription, &|p| {
             atelier_body::description::BodyDescription::load(p).map(|_| ())
@@ -158,10 +158,17 @@ pub fn validate(path: &Path) -> Outcome {
         match attempt(path) {
             Ok(()) => return Ok(kind),
             Err(e) => {
-                let further = match (&best, e.position) {
-                    (None, _) => true,
-                    (Some((_, b)), Some(p)) => b.position.is_none_or(|q| later(p, q)),
-                    (Some(_), None) => false,
+                // An error found after the file was read as this kind (no position in it, or
+                // in a file it names) goes furthest of all: the file is that kind.
+                let read_as = |e: &FileError| e.position.is_none() || e.file != path;
+                let further = match &best {
+                    None => true,
+                    Some((_, b)) if read_as(b) => false,
+                    Some(_) if read_as(&e) => true,
+                    Some((_, b)) => match (e.position, b.position) {
+                        (Some(p), Some(q)) => later(p, q),
+                        _ => false,
+                    },
                 };
                 if further {
                     best = Some((kind, e));

@@ -12,7 +12,7 @@
 
 use atelier_grid::ImproveParams;
 use atelier_grid::pattern::{
-    DartSpec, Outline, Panel, PatternSpec, Segment, TeamSpec, grid_pattern,
+    DartSpec, Outline, Panel, PatternSpec, Segment, TeamSpec, grid_fitting_darts, grid_pattern,
 };
 
 use crate::error::PieceProblem;
@@ -313,36 +313,20 @@ fn grid_shortening_darts(
     provenance: &str,
     params: ImproveParams,
 ) -> Result<(Plan, Panel), PieceProblem> {
-    let mut legs = options.dart_cells.clone();
-    loop {
-        let o = PanelOptions {
-            corners: Some(corners),
-            dart_cells: legs.clone(),
-            ..options.clone()
-        };
-        let p = plan(piece, &o, provenance)?;
-        let e = match grid_pattern(&p.spec, params) {
-            Ok(panel) => return Ok((p, panel)),
-            Err(e) => e,
-        };
-        let overlapping = e
-            .field
-            .strip_prefix("darts[")
-            .and_then(|r| r.split(']').next())
-            .and_then(|k| k.parse::<usize>().ok())
-            .filter(|_| {
-                options.dart_cells.is_none()
-                    && (e.message.contains("overlaps") || e.message.contains("they need"))
-            });
-        let mut cells: Vec<usize> = p.spec.darts.iter().map(|d| d.cells).collect();
-        match overlapping {
-            Some(k) if cells.get(k).is_some_and(|&c| c > 1) => {
-                cells[k] -= 1;
-                legs = Some(cells);
-            }
-            _ => return Err(PieceProblem::Sides(format!("cannot grid it: {e}"))),
-        }
+    let o = PanelOptions {
+        corners: Some(corners),
+        ..options.clone()
+    };
+    let mut p = plan(piece, &o, provenance)?;
+    let cannot = |e| PieceProblem::Sides(format!("cannot grid it: {e}"));
+    if options.dart_cells.is_some() {
+        // Leg counts given are never changed.
+        let panel = grid_pattern(&p.spec, params).map_err(cannot)?;
+        return Ok((p, panel));
     }
+    let (spec, panel) = grid_fitting_darts(p.spec, params).map_err(cannot)?;
+    p.spec = spec;
+    Ok((p, panel))
 }
 
 /// Cells per team: opposite sides (0 and 2, 1 and 3) share a total, the longer side's length
