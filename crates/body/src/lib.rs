@@ -14,6 +14,7 @@ pub mod model;
 pub mod motion;
 pub mod part;
 pub mod range;
+pub mod scan;
 #[cfg(test)]
 mod testing;
 
