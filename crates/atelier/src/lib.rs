@@ -40,6 +40,8 @@ pub mod simulation;
 pub mod wet;
 
 pub use assemble::{AssembleError, GarmentCloth};
-pub use scene::{ClothSolver, Garment, GarmentSpec, Scene, SceneError, Settings};
+pub use scene::{
+    BodyScanSpec, ClothSolver, Garment, GarmentSpec, LengthUnit, Scene, SceneError, Settings,
+};
 pub use sewing::{Chain, Sewing, SewingParams};
 pub use simulation::{Phase, Simulation, SimulationError, StepOutcome};

@@ -36,15 +36,66 @@ pub struct GarmentSpec {
     /// Clearance and ease of the placement.
     #[serde(default)]
     pub place: PlaceParams,
-    /// Body description file (RON); the built-in JIS 9AR mannequin when absent.
+    /// Body description file (RON), or a body scan (`.obj`, `.ply`, in metres; see
+    /// `body_scan` for other units and a landmark file); the built-in JIS 9AR mannequin when
+    /// absent.
     #[serde(default)]
     pub body: Option<PathBuf>,
+    /// A body scan with its unit and landmark file (instead of `body`).
+    #[serde(default)]
+    pub body_scan: Option<BodyScanSpec>,
     /// Motion file (RON) the body performs after the garment has settled; none: stand still.
     #[serde(default)]
     pub motion: Option<PathBuf>,
     /// Physics and schedule.
     #[serde(default)]
     pub settings: Settings,
+}
+
+/// A body scan as a garment scene's body (`docs/body.md`, "Scans"): repaired, landmarked,
+/// segmented into the 17 parts and articulated; the garment collides with the scan's own
+/// surface.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyScanSpec {
+    /// The mesh (OBJ or ASCII PLY), relative to the scenario's folder.
+    pub mesh: PathBuf,
+    /// Its length unit (default `m`).
+    #[serde(default)]
+    pub unit: LengthUnit,
+    /// A landmark file (RON) giving or overriding landmarks.
+    #[serde(default)]
+    pub landmarks: Option<PathBuf>,
+}
+
+/// A mesh file's length unit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LengthUnit {
+    /// Metres.
+    #[default]
+    M,
+    /// Decimetres.
+    Dm,
+    /// Centimetres.
+    Cm,
+    /// Millimetres.
+    Mm,
+    /// Inches.
+    In,
+}
+
+impl LengthUnit {
+    /// Metres per unit.
+    pub fn metres(self) -> f64 {
+        match self {
+            LengthUnit::M => 1.0,
+            LengthUnit::Dm => 0.1,
+            LengthUnit::Cm => 0.01,
+            LengthUnit::Mm => 0.001,
+            LengthUnit::In => 0.0254,
+        }
+    }
 }
 
 /// How the garment gets onto the body.
@@ -387,6 +438,17 @@ pub enum SceneError {
     /// The body's parts could not be set up as rigid colliders.
     #[error("body: {0}")]
     Parts(#[from] atelier_collide::parts::PartsError),
+    /// A body scan could not be made a body (the mesh named first).
+    #[error("{}: {source}", file.display())]
+    Scan {
+        /// The mesh.
+        file: PathBuf,
+        /// Why.
+        source: atelier_body::scan::ScanError,
+    },
+    /// `body` and `body_scan` both given.
+    #[error("a garment scene takes `body` or `body_scan`, not both")]
+    TwoBodies,
 }
 
 impl Garment {
@@ -428,6 +490,9 @@ pub struct Scene {
     pub motion: Option<Motion>,
     /// Physics and schedule.
     pub settings: Settings,
+    /// What was done to the body before the run (a scan's repair and landmarks), reported with
+    /// the run's warnings.
+    pub notes: Vec<String>,
 }
 
 impl Scene {
@@ -444,6 +509,7 @@ impl Scene {
             body: Body::new(mannequin),
             motion,
             settings,
+            notes: Vec::new(),
         })
     }
 
@@ -457,9 +523,34 @@ impl Scene {
             spec.placements.clone(),
             spec.place,
         )?;
-        let mannequin = match &spec.body {
-            None => atelier_body::build::jis_9ar(),
-            Some(p) => {
+        let is_mesh = |p: &Path| {
+            matches!(
+                p.extension()
+                    .and_then(|e| e.to_str())
+                    .map(str::to_ascii_lowercase)
+                    .as_deref(),
+                Some("obj" | "ply")
+            )
+        };
+        let scan = match (&spec.body, &spec.body_scan) {
+            (Some(_), Some(_)) => return Err(SceneError::TwoBodies),
+            (None, Some(s)) => Some(s.clone()),
+            (Some(p), None) if is_mesh(p) => Some(BodyScanSpec {
+                mesh: p.clone(),
+                unit: LengthUnit::M,
+                landmarks: None,
+            }),
+            _ => None,
+        };
+        let mut notes = Vec::new();
+        let mannequin = match (&spec.body, scan) {
+            (_, Some(s)) => {
+                let (mannequin, said) = load_scan(&s, base)?;
+                notes = said;
+                mannequin
+            }
+            (None, None) => atelier_body::build::jis_9ar(),
+            (Some(p), None) => {
                 let d = atelier_body::description::BodyDescription::load(&resolve(p))?;
                 Mannequin::from_description(&d, &d.sizes).map_err(|source| {
                     SceneError::Mannequin {
@@ -475,8 +566,65 @@ impl Scene {
             }
             _ => None,
         };
-        Self::new(garment, mannequin, motion, spec.settings.clone())
+        let mut scene = Self::new(garment, mannequin, motion, spec.settings.clone())?;
+        scene.notes = notes;
+        Ok(scene)
     }
+}
+
+/// A body scan as a mannequin, with what was done to it in words.
+fn load_scan(s: &BodyScanSpec, base: &Path) -> Result<(Mannequin, Vec<String>), SceneError> {
+    use atelier_body::scan::{LandmarkFile, ScanOptions, mannequin, prepare};
+    let file = base.join(&s.mesh);
+    let mesh = atelier_body::io::load_mesh_with(
+        &file,
+        &atelier_body::io::LoadOptions {
+            require_closed: false,
+            scale: s.unit.metres(),
+        },
+    )?;
+    let overrides = s
+        .landmarks
+        .as_ref()
+        .map(|p| LandmarkFile::load(&base.join(p)))
+        .transpose()?;
+    let fail = |source| SceneError::Scan {
+        file: file.clone(),
+        source,
+    };
+    let scan = prepare(mesh, &ScanOptions::default(), overrides.as_ref()).map_err(fail)?;
+    let body = mannequin(&scan).map_err(fail)?;
+    let r = &scan.repair;
+    let mut notes: Vec<String> = r
+        .holes
+        .iter()
+        .map(|h| {
+            format!(
+                "body scan: a hole of {} vertices ({:.1} cm of border) at ({:.3}, {:.3}, {:.3}) m closed with {} triangles",
+                h.vertices,
+                100.0 * h.perimeter,
+                h.centroid.x,
+                h.centroid.y,
+                h.centroid.z,
+                h.triangles_added
+            )
+        })
+        .collect();
+    notes.extend(r.warnings.iter().map(|w| format!("body scan: {w}")));
+    let l = &scan.landmarks;
+    notes.push(format!(
+        "body scan {}: {} vertices, {} triangles, height {:.1} cm; waist {:.1} cm at {:.3} m, hip {:.1} cm at {:.3} m, crotch at {:.3} m",
+        file.display(),
+        scan.mesh.vertices.len(),
+        scan.mesh.triangles.len(),
+        100.0 * r.height,
+        100.0 * l.waist.girth,
+        l.waist.height,
+        100.0 * l.hip.girth,
+        l.hip.height,
+        l.crotch.y
+    ));
+    Ok((body, notes))
 }
 
 #[cfg(test)]

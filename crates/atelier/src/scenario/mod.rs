@@ -472,6 +472,12 @@ impl Scenario {
             if let Some(b) = &g.body {
                 files.push(("kind.body", b));
             }
+            if let Some(s) = &g.body_scan {
+                files.push(("kind.body_scan.mesh", &s.mesh));
+                if let Some(l) = &s.landmarks {
+                    files.push(("kind.body_scan.landmarks", l));
+                }
+            }
             if let Some(m) = &g.motion {
                 files.push(("kind.motion", m));
             }

@@ -282,7 +282,7 @@ impl Simulation {
             sewn_at: None,
             last_inside: 0,
             start_positions: Vec::new(),
-            warnings: Vec::new(),
+            warnings: scene.notes.clone(),
             scene,
         })
     }

@@ -97,9 +97,9 @@ pub enum ScanError {
     },
     /// The height is not a person's in metres: probably other units.
     #[error(
-        "height {height} (highest − lowest y) is outside {min}…{max} m{}",
+        "height {height:.6} m (highest − lowest y, as read) is outside {min}…{max} m{}",
         match (unit, scale) {
-            (Some(u), Some(s)) => format!(": the file looks like it is in {u}; multiply its coordinates by {s} (`LoadOptions::scale`)"),
+            (Some(u), Some(s)) => format!(": the file looks like it is in {u}; multiply its coordinates by {s} (a scene's `body_scan.unit`, `LoadOptions::scale`)"),
             _ => String::from(": not a body in any of mm, cm, dm or m (is y up?)"),
         }
     )]
@@ -227,11 +227,38 @@ pub fn prepare(
 pub const ARTICULATE_REACH: f64 = 0.01;
 
 /// The scan as an articulated mannequin: [`articulate`] with the 9AR mannequin's joint limits
-/// and [`ARTICULATE_REACH`].
+/// and [`ARTICULATE_REACH`], then every part closed where it was cut from its neighbours, since
+/// contact needs closed parts: each cut border is capped by a fan from a new vertex at its
+/// centroid (a fan adds no edge between border vertices, so it closes any border, planar or
+/// not, where ear clipping can meet an existing edge: the cut under the jaw does). The caps lie
+/// where two parts touch, inside the body: a point outside is nearest to the scan's own surface
+/// (or to a cap's rim, which lies on it), so contact is against the scan itself; a point inside
+/// near a cut is given the depth to the nearer cap (less than its depth into the body).
 pub fn mannequin(scan: &Scan) -> Result<Mannequin, ScanError> {
-    Ok(articulate(
-        &scan.mesh,
-        &crate::build::jis_9ar(),
-        ARTICULATE_REACH,
-    )?)
+    let mut m = articulate(&scan.mesh, &crate::build::jis_9ar(), ARTICULATE_REACH)?;
+    for part in &mut m.parts {
+        let loops = repair::borders(&part.triangles, &part.vertices)?;
+        for border in &loops {
+            let centre = part.vertices.len() as u32;
+            let n = border.len();
+            part.vertices.push(
+                border
+                    .iter()
+                    .map(|&k| part.vertices[k as usize])
+                    .sum::<V3>()
+                    / n as f64,
+            );
+            // The border runs a → b along the part's own triangles; the cap runs b → a.
+            part.triangles
+                .extend((0..n).map(|k| [border[(k + 1) % n], border[k], centre]));
+        }
+        if let Some((_, [a, b])) = crate::build::first_open_edge(&part.triangles) {
+            return Err(ScanError::NotClosed {
+                vertices: [a, b],
+                at: 0.5 * (part.vertices[a as usize] + part.vertices[b as usize]),
+            });
+        }
+    }
+    m.name = "body scan".into();
+    Ok(m)
 }

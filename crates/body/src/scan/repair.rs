@@ -347,7 +347,7 @@ fn orient(
 
 /// The borders of the mesh: loops of directed open edges (a → b runs along the mesh's own
 /// triangles), as vertex lists in that direction.
-fn borders(triangles: &[[u32; 3]], vertices: &[V3]) -> Result<Vec<Vec<u32>>, ScanError> {
+pub(crate) fn borders(triangles: &[[u32; 3]], vertices: &[V3]) -> Result<Vec<Vec<u32>>, ScanError> {
     let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(3 * triangles.len());
     for t in triangles {
         for e in 0..3 {
