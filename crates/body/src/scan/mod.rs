@@ -262,3 +262,25 @@ pub fn mannequin(scan: &Scan) -> Result<Mannequin, ScanError> {
     m.name = "body scan".into();
     Ok(m)
 }
+
+/// The mesh refined 1-to-4: every triangle split at its edges' midpoints (a finer scan of the
+/// same surface, for the benchmarks' larger scans).
+pub fn subdivided(v: &[V3], t: &[[u32; 3]]) -> (Vec<V3>, Vec<[u32; 3]>) {
+    let mut v = v.to_vec();
+    let mut mid: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    let mut out = Vec::with_capacity(4 * t.len());
+    for tri in t {
+        let m = [0, 1, 2].map(|e| {
+            let (a, b) = (tri[e], tri[(e + 1) % 3]);
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                v.push((v[a as usize] + v[b as usize]) / 2.0);
+                (v.len() - 1) as u32
+            })
+        });
+        out.push([tri[0], m[0], m[2]]);
+        out.push([tri[1], m[1], m[0]]);
+        out.push([tri[2], m[2], m[1]]);
+        out.push(m);
+    }
+    (v, out)
+}
