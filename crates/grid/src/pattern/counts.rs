@@ -121,8 +121,8 @@ pub fn match_seam_counts(
             parent[ra] = rb;
         }
     }
-    for k in 0..slots.len() {
-        slots[k].class = root(&mut parent, k);
+    for (k, slot) in slots.iter_mut().enumerate() {
+        slot.class = root(&mut parent, k);
     }
     let name = |k: usize| {
         let n = index[slots[k].panel]
@@ -266,7 +266,9 @@ pub fn match_seam_counts(
 /// scales with the left/right total, one opening on the left or right side with the bottom/top
 /// total. `before` is the same pattern as planned.
 pub fn rescale_darts(before: &PatternSpec, after: &mut PatternSpec) {
-    let totals = |s: &PatternSpec| -> Option<([usize; 4], Vec<(String, usize)>)> {
+    // Each side's total cells, and the side each team lies on.
+    type Sides = ([usize; 4], Vec<(String, usize)>);
+    let totals = |s: &PatternSpec| -> Option<Sides> {
         let sides = s.resolve();
         if sides.len() != 4 {
             return None;
