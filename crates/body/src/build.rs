@@ -459,7 +459,7 @@ pub fn hull_girth(parts: &[PartMesh], y: f64) -> f64 {
 }
 
 /// Convex hull (Andrew's monotone chain), counter-clockwise, no repeated points.
-fn convex_hull(mut pts: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+pub(crate) fn convex_hull(mut pts: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     pts.retain(|p| p.0.is_finite() && p.1.is_finite());
     pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     pts.dedup();

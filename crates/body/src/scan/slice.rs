@@ -164,36 +164,12 @@ fn chain(segs: Vec<[(u64, V3); 2]>) -> Vec<Contour> {
     out
 }
 
-/// Perimeter of the convex hull of points in the (x, z) plane.
+/// Perimeter of the convex hull of points in the (x, z) plane (twice the distance for two
+/// distinct points, 0 for one).
 pub(crate) fn hull_perimeter_xz(points: impl Iterator<Item = V3>) -> f64 {
-    let mut pts: Vec<(f64, f64)> = points.map(|p| (p.x, p.z)).collect();
-    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    pts.dedup();
-    if pts.len() < 3 {
-        return if pts.len() == 2 {
-            2.0 * (pts[1].0 - pts[0].0).hypot(pts[1].1 - pts[0].1)
-        } else {
-            0.0
-        };
-    }
-    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
-        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
-    };
-    let mut h: Vec<(f64, f64)> = Vec::with_capacity(2 * pts.len());
-    for pass in 0..2 {
-        let start = h.len();
-        let it: Box<dyn Iterator<Item = &(f64, f64)>> = if pass == 0 {
-            Box::new(pts.iter())
-        } else {
-            Box::new(pts.iter().rev())
-        };
-        for &p in it {
-            while h.len() >= start + 2 && cross(h[h.len() - 2], h[h.len() - 1], p) <= 0.0 {
-                h.pop();
-            }
-            h.push(p);
-        }
-        h.pop();
+    let h = crate::build::convex_hull(points.map(|p| (p.x, p.z)).collect());
+    if h.len() < 2 {
+        return 0.0;
     }
     (0..h.len())
         .map(|k| {
