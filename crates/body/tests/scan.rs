@@ -750,3 +750,38 @@ fn the_articulated_scan_has_closed_parts_that_keep_its_surface() {
         scan.repair.volume
     );
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+    /// Hostile meshes (random points and triangles, a scaled or torn MakeHuman) are refused or
+    /// prepared, never a panic.
+    #[test]
+    fn hostile_meshes_never_panic(
+        points in proptest::collection::vec((-2.0f64..2.0, 0.0f64..2.0, -2.0f64..2.0), 3..40),
+        faces in proptest::collection::vec((0u32..40, 0u32..40, 0u32..40), 1..60),
+        keep in 0.0f64..1.0,
+        scale in 0.2f64..3.0,
+    ) {
+        let n = points.len() as u32;
+        let random = ExternalBody {
+            vertices: points.iter().map(|&(x, y, z)| V3::new(x, y, z)).collect(),
+            triangles: faces.iter().map(|&(a, b, c)| [a % n, b % n, c % n]).collect(),
+            ..ExternalBody::default()
+        };
+        let _ = prepare(random, &ScanOptions::default(), None);
+        // The scan scaled and with a share of its triangles dropped (holes of every size).
+        let mut torn = makehuman();
+        for v in &mut torn.vertices {
+            *v *= scale;
+        }
+        let total = torn.triangles.len();
+        let mut k = 0usize;
+        torn.triangles.retain(|_| {
+            k += 1;
+            (k * 7919 % total) as f64 / total as f64 >= keep * 0.05
+        });
+        if let Ok(scan) = prepare(torn, &ScanOptions::default(), None) {
+            let _ = mannequin(&scan);
+        }
+    }
+}
