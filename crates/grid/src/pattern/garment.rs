@@ -195,6 +195,10 @@ pub fn load_garment_with(
         source: None,
     };
     // Seams by panel index, their teams checked to exist.
+    let team_names: Vec<Vec<String>> = specs
+        .iter()
+        .map(|s| s.resolve().into_iter().flatten().map(|t| t.name).collect())
+        .collect();
     let mut joined = Vec::with_capacity(spec.seams.len());
     for (k, s) in spec.seams.iter().enumerate() {
         let find = |(panel, team): &(String, String)| -> Result<usize, FileError> {
@@ -209,12 +213,7 @@ pub fn load_garment_with(
                         format!("no panel named `{panel}`"),
                     )
                 })?;
-            if !specs[pi]
-                .resolve()
-                .iter()
-                .flatten()
-                .any(|t| t.name == *team)
-            {
+            if !team_names[pi].contains(team) {
                 return Err(fail(
                     k,
                     ErrorKind::Inconsistent,
