@@ -213,16 +213,27 @@ pub fn simulate(
         progress(1.0);
         return Ok(sim);
     };
-    let fabric_path = base.join(fabric_file);
-    let fabric = Fabric::load(&fabric_path)?;
+    let fabric = Fabric::load(&base.join(fabric_file))?;
+    simulate_with_fabric(scenario, &fabric, base, progress)
+}
+
+/// Simulate a scenario with `fabric` in place of the fabric file it names (nothing is written;
+/// a garment scene still reads its own fabric file, which its panels name): what the Python
+/// bindings run for a fabric built in memory. `base` resolves the other relative paths.
+pub fn simulate_with_fabric(
+    scenario: &Scenario,
+    fabric: &Fabric,
+    base: &Path,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulated, RunError> {
     let mut sim = match &scenario.kind {
         ScenarioKind::Garment(spec) => garment(spec, base, progress)?,
-        ScenarioKind::Drape(spec) => drape(spec, &fabric, progress)?,
-        ScenarioKind::Cantilever(spec) => cantilever(spec, &fabric, progress)?,
-        ScenarioKind::Catenary(spec) => catenary(spec, &fabric, progress)?,
-        ScenarioKind::KesTensile(spec) => kes_tensile(spec, &fabric)?,
-        ScenarioKind::KesBending(spec) => kes_bending(spec, &fabric)?,
-        ScenarioKind::Wet(spec) => crate::wet::simulate(spec, &fabric)?,
+        ScenarioKind::Drape(spec) => drape(spec, fabric, progress)?,
+        ScenarioKind::Cantilever(spec) => cantilever(spec, fabric, progress)?,
+        ScenarioKind::Catenary(spec) => catenary(spec, fabric, progress)?,
+        ScenarioKind::KesTensile(spec) => kes_tensile(spec, fabric)?,
+        ScenarioKind::KesBending(spec) => kes_bending(spec, fabric)?,
+        ScenarioKind::Wet(spec) => crate::wet::simulate(spec, fabric)?,
         ScenarioKind::StringFit(spec) => crate::fit::simulate(spec, base)?,
     };
     sim.fabric = fabric.name.clone();
