@@ -153,8 +153,10 @@ pub struct Simulated {
 /// What a run adds to the cloth's frames, by scene kind.
 #[derive(Clone, Debug)]
 pub enum KindOutputs {
-    /// Nothing: the final state's views are the pictures (garments, drapes, strips).
+    /// Nothing: the final state's views are the pictures (garments, strips).
     Cloth,
+    /// A drape test: its final outline seen from above, with the counted nodes.
+    Drape(DrapeTop),
     /// A virtual KES test: its loop, drawn instead of the final state's views.
     Chart(Chart),
     /// A wet scene: its series and charts, and the compared run's cost if there was one.
@@ -171,6 +173,28 @@ impl Simulated {
             _ => None,
         }
     }
+
+    /// The top view of a drape test.
+    pub fn drape_top(&self) -> Option<&DrapeTop> {
+        match &self.outputs {
+            KindOutputs::Drape(top) => Some(top),
+            _ => None,
+        }
+    }
+}
+
+/// A drape test's final state seen from above, in the horizontal plane (x, z) of the outputs'
+/// y-up frame, m: what the report's `drape` section and the viewer's top view show.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DrapeTop {
+    /// The specimen's outer edge, one point per node of its outer ring, in ring order.
+    pub outline_m: Vec<[f64; 2]>,
+    /// The counted nodes (folds): the outer-edge point at the top of each.
+    pub node_points_m: Vec<[f64; 2]>,
+    /// Radius of the support disk, m.
+    pub support_radius_m: f64,
+    /// Radius of the flat specimen, m.
+    pub specimen_radius_m: f64,
 }
 
 /// What a wet run adds to the usual outputs: the series, charts and the compared run's final

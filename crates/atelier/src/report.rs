@@ -129,6 +129,9 @@ pub struct Report {
     /// The compared run of a wet scene (absent otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub comparison: Option<Comparison>,
+    /// A drape test's final outline and nodes seen from above (drape runs only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drape: Option<crate::outcome::DrapeTop>,
     /// The try-on's fit and composite (`atelier tryon` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tryon: Option<TryonInfo>,
@@ -183,6 +186,7 @@ impl Report {
             convergence: sim.convergence.clone(),
             outputs: Vec::new(),
             comparison: sim.comparison().cloned(),
+            drape: sim.drape_top().cloned(),
             tryon: None,
         }
     }

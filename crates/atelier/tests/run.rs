@@ -230,6 +230,26 @@ fn a_drape_run_measures_its_drape() {
     assert!(m("min_edge_radius_m") <= m("max_edge_radius_m"));
     assert_eq!(m("nodes") as usize, 96);
     assert!(report.outputs.iter().any(|o| o == outputs::TOP));
+    // The top view the viewer draws: the tester of JIS L 1096 (specimen Ø 254 mm on a support
+    // Ø 127 mm), the outer ring's 24 points, whose extreme radii are the measured ones, and one
+    // outline point per counted node.
+    let top = report
+        .drape
+        .as_ref()
+        .expect("a drape run reports its top view");
+    assert_eq!(
+        (top.specimen_radius_m, top.support_radius_m),
+        (0.127, 0.0635)
+    );
+    assert_eq!(top.outline_m.len(), 24);
+    let radii: Vec<f64> = top.outline_m.iter().map(|p| p[0].hypot(p[1])).collect();
+    let (lo, hi) = radii.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &r| {
+        (lo.min(r), hi.max(r))
+    });
+    assert!((lo - m("min_edge_radius_m")).abs() < 1e-12);
+    assert!((hi - m("max_edge_radius_m")).abs() < 1e-12);
+    assert_eq!(top.node_points_m.len(), m("node_count") as usize);
+    assert!(top.node_points_m.iter().all(|p| top.outline_m.contains(p)));
     std::fs::remove_dir_all(&out).ok();
 }
 

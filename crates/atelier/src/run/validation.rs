@@ -13,7 +13,7 @@ use nalgebra::Vector3;
 use super::to_y_up;
 use crate::convergence::{Convergence, Tally, solvers};
 use crate::export::Animation;
-use crate::outcome::{KindOutputs, RunError, Simulated, Solid};
+use crate::outcome::{DrapeTop, KindOutputs, RunError, Simulated, Solid};
 use crate::scenario::{
     CantileverSpec, CatenarySpec, DrapeSpec, KesBendingSpec, KesTensileSpec, StripDirection, Tester,
 };
@@ -211,6 +211,17 @@ pub(super) fn drape(
     );
     let mut sim = stepper.into_simulated(&cloth, &state, input.dt, Some(support), metrics);
     sim.warnings.extend(warnings);
+    if ok {
+        // In the outputs' y-up frame the horizontal plane is (x, z) = (x, −y) of the z-up scene.
+        let flat = |p: &Vector3<f64>| [p.x, -p.y];
+        let ring = &state.positions[scene.outer_ring()];
+        sim.outputs = KindOutputs::Drape(DrapeTop {
+            outline_m: ring.iter().map(flat).collect(),
+            node_points_m: m.folds.iter().map(|f| flat(&ring[f.index])).collect(),
+            support_radius_m: scene.support_radius(),
+            specimen_radius_m: scene.specimen_radius(),
+        });
+    }
     Ok(sim)
 }
 
