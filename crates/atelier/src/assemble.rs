@@ -13,6 +13,8 @@ pub struct GarmentCloth {
     pub cloth: Cloth,
     /// First node of each panel in the joint cloth.
     pub offsets: Vec<u32>,
+    /// Name of each panel.
+    pub panel_names: Vec<String>,
     /// Node pairs to sew: seams then darts, in the joint cloth's numbering.
     pub pairs: Vec<(u32, u32)>,
     /// For each pair, the seam or dart it belongs to.
@@ -57,6 +59,7 @@ impl GarmentCloth {
         }
         Ok(Self {
             cloth: Cloth::new(topology, fabric, form)?,
+            panel_names: garment.panels.iter().map(|p| p.name.clone()).collect(),
             offsets,
             pairs,
             pair_names,

@@ -168,6 +168,7 @@ pub fn simulate(spec: &StringFitSpec, base: &Path) -> Result<Simulated, RunError
         failure: None,
         outputs: KindOutputs::Fit(Box::new(FitOutputs { parameters_ron }), chart),
         convergence: None,
+        detail: crate::outcome::ClothDetail::default(),
     })
 }
 

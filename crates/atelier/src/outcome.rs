@@ -148,6 +148,20 @@ pub struct Simulated {
     pub outputs: KindOutputs,
     /// Whether the steps converged (`None`: no solver stepped, the string identification).
     pub convergence: Option<Convergence>,
+    /// Strain errors per frame and panels per node, where the run knows them.
+    pub detail: ClothDetail,
+}
+
+/// What a run knows of its cloth beyond positions, for the viewer (`run.glb`'s colours).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ClothDetail {
+    /// Per recorded frame (as `Simulated::cloth`'s), each node's largest axial strain error
+    /// |ε − ε̄| (the solver's `max_strain_error` per node); empty when not recorded.
+    pub strain_error: Vec<Vec<f32>>,
+    /// Names of the garment's panels; empty for a one-piece cloth.
+    pub panels: Vec<String>,
+    /// The panel of each node (index into `panels`); empty for a one-piece cloth.
+    pub node_panel: Vec<u16>,
 }
 
 /// What a run adds to the cloth's frames, by scene kind.

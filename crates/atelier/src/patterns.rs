@@ -214,6 +214,8 @@ pub fn write_pieces(imported: &Imported, out: &Path) -> Result<Vec<PathBuf>, Pat
             .map(|q| [q[0], q[1], 0.0])
             .collect();
         let part = MeshPart {
+            vertex_colours: None,
+            frame_values: None,
             name: &p.piece.name,
             triangles: topology.triangles(),
             colour: [0.8, 0.8, 0.8],

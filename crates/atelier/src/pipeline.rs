@@ -23,6 +23,9 @@ pub struct Frame {
     pub cloth: Vec<[f64; 3]>,
     /// Body vertex positions, m.
     pub body: Vec<[f64; 3]>,
+    /// Each cloth node's largest axial strain error (`Simulation::node_strain_errors`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub strain_error: Vec<f32>,
 }
 
 /// What a garment run produced.
@@ -64,6 +67,8 @@ pub struct GarmentRun {
     pub failure: Option<String>,
     /// Things the user should know.
     pub warnings: Vec<String>,
+    /// The garment's panel names and the panel of each cloth node.
+    pub panels: (Vec<String>, Vec<u16>),
 }
 
 impl GarmentRun {
@@ -93,6 +98,7 @@ impl GarmentRun {
             convergence: Convergence::not_reported(solvers::PARTY, 0),
             failure: None,
             warnings: Vec::new(),
+            panels: (Vec::new(), Vec::new()),
         }
     }
 
@@ -146,6 +152,7 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
         phase: sim.phase(),
         cloth: to3(&sim.state().positions),
         body: to3(sim.body_positions()),
+        strain_error: sim.node_strain_errors(),
     };
     let mut run = GarmentRun::started(
         sim.cloth_triangles().to_vec(),
@@ -193,6 +200,7 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
     run.pairs = sim.sewing_progress();
     run.sewn_at = sim.sewn_at();
     run.warnings = sim.warnings().to_vec();
+    run.panels = sim.node_panels();
     run.convergence = match baseline {
         None => tally.convergence(tolerance),
         Some(name) => Convergence::not_reported(name, run.steps),
@@ -214,6 +222,7 @@ mod tests {
             phase: Phase::Settling,
             cloth,
             body: Vec::new(),
+            strain_error: Vec::new(),
         }
     }
 

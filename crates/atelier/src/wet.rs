@@ -217,6 +217,7 @@ pub fn simulate(spec: &WetSpec, fabric: &Fabric) -> Result<Simulated, RunError> 
             .map(|f| format!("t = {:.4} s: {}", f.time, f.error)),
         outputs: KindOutputs::Wet(Box::new(wet), comparison),
         convergence: Some(convergence(&main)),
+        detail: crate::outcome::ClothDetail::default(),
     })
 }
 

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use atelier::export::{
-    Animation, ExportError, FrameSelection, GlbOptions, Interpolation, MeshPart, write_glb,
-    write_obj, write_ply,
+    Animation, ExportError, FrameSelection, FrameValues, GlbOptions, Interpolation, MeshPart,
+    write_glb, write_obj, write_ply,
 };
 use serde_json::Value;
 
@@ -410,6 +410,82 @@ fn glb_frames_can_be_subsampled_and_output_is_deterministic() {
     };
     let err = write_glb(&dir.join("c.glb"), &scene, &bad).expect_err("invalid selection");
     assert!(matches!(err, ExportError::InvalidScene { .. }), "{err}");
+}
+
+#[test]
+fn glb_carries_vertex_colours_and_values_per_kept_frame_for_the_viewer() {
+    let dir = scratch("viewer_extras");
+    let (body, cloth) = parts();
+    let names = vec!["front".to_string(), "back".to_string()];
+    // sRGB 0.5 is linear 0.21404114 (IEC 61966-2-1); 0 and 1 map to themselves.
+    let colours = [
+        [0.0, 0.5, 1.0],
+        [0.0, 0.5, 1.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+    ];
+    let values: Vec<Vec<f32>> = (0..TIMES.len())
+        .map(|k| (0..4).map(|v| (10 * k + v) as f32 * 1e-3).collect())
+        .collect();
+    let mut cloth_p = cloth_part();
+    cloth_p.vertex_colours = Some((&colours, &names));
+    cloth_p.frame_values = Some(FrameValues {
+        name: "strain_error",
+        values: &values,
+    });
+    let options = GlbOptions {
+        frames: FrameSelection::AtMost(2),
+        ..GlbOptions::default()
+    };
+    let path = dir.join("run.glb");
+    write_glb(&path, &[(body_part(), &body), (cloth_p, &cloth)], &options).expect("glb");
+    let (doc, bin) = read_glb(&path);
+    let mesh = &doc["meshes"][1];
+    assert_eq!(
+        mesh["extras"]["panels"],
+        serde_json::json!(["front", "back"])
+    );
+    let colour = mesh["primitives"][0]["attributes"]["COLOR_0"]
+        .as_u64()
+        .expect("COLOR_0");
+    let linear = vec3s(&floats(&doc, &bin, colour));
+    assert!((linear[0][1] - 0.214_041_14).abs() < 1e-6, "{linear:?}");
+    assert_eq!(linear[2], [1.0, 0.0, 0.0]);
+    // The first and last frame are kept: their values, in that order.
+    let extra = &mesh["extras"]["strain_error"];
+    let accessors: Vec<u64> = extra["accessors"]
+        .as_array()
+        .expect("accessors")
+        .iter()
+        .map(|a| a.as_u64().expect("index"))
+        .collect();
+    assert_eq!(accessors.len(), 2);
+    assert_eq!(floats(&doc, &bin, accessors[0]), values[0]);
+    assert_eq!(floats(&doc, &bin, accessors[1]), values[TIMES.len() - 1]);
+    assert_eq!(
+        extra["max"].as_f64().expect("max") as f32,
+        values[TIMES.len() - 1][3]
+    );
+    // The body carries neither.
+    assert!(
+        doc["meshes"][0]["primitives"][0]["attributes"]
+            .get("COLOR_0")
+            .is_none()
+    );
+
+    // Values for fewer frames than the animation holds are refused, and nothing is written.
+    cloth_p.frame_values = Some(FrameValues {
+        name: "strain_error",
+        values: &values[..1],
+    });
+    let err = write_glb(&dir.join("bad.glb"), &[(cloth_p, &cloth)], &options)
+        .expect_err("values for one frame of three");
+    assert!(
+        err.to_string()
+            .contains("strain_error: 1 lists of values for 3 frames"),
+        "{err}"
+    );
+    assert!(!dir.join("bad.glb").exists());
 }
 
 #[test]

@@ -45,6 +45,24 @@ pub trait Integrator: Send {
         let _ = forces;
         false
     }
+
+    /// Per node, the largest strain error of its axial edges in `state` (what a viewer colours
+    /// the cloth by). Default (the baselines, which have no target length): the strain from the
+    /// rest length, |ℓ/ℓ₀ − 1|.
+    fn node_strain_errors(&self, cloth: &Cloth, state: &ClothState) -> Vec<f32> {
+        let edges = cloth.topology().edges();
+        let pos = &state.positions;
+        let mut out = vec![0.0_f32; pos.len()];
+        for &e in cloth.axial_edge_list() {
+            let edge = &edges[e as usize];
+            let l = (pos[edge.b as usize] - pos[edge.a as usize]).norm();
+            let err = ((l - edge.rest_length) / edge.rest_length).abs() as f32;
+            for n in [edge.a, edge.b] {
+                out[n as usize] = out[n as usize].max(err);
+            }
+        }
+        out
+    }
 }
 
 /// The PARTY step with its parameters.
@@ -78,6 +96,10 @@ impl Integrator for Party {
     fn set_external_forces(&mut self, forces: Vec<Vector3<f64>>) -> bool {
         self.solver.external_forces = forces;
         true
+    }
+
+    fn node_strain_errors(&self, cloth: &Cloth, state: &ClothState) -> Vec<f32> {
+        self.solver.node_strain_errors(cloth, state, &self.params)
     }
 }
 
@@ -172,6 +194,53 @@ mod tests {
         }
         let state = ClothState::flat(&cloth, 0.0);
         (cloth, state)
+    }
+
+    /// The per-node strain errors the viewer colours by, against known answers: the flat
+    /// sheet has none; one corner node moved outward along the warp stretches the one axial
+    /// edge along it by a known strain (its node and its neighbour show it; the node's other
+    /// edge, across the warp, is stretched by the second order only); after a PARTY step the
+    /// nodes' largest value is the step's `max_strain_error`.
+    #[test]
+    fn node_strain_errors_are_the_edges_strains_and_match_the_step_report() {
+        let (cloth, mut state) = sheet();
+        let party = Party {
+            solver: Solver::new(),
+            params: StepParams::default(),
+        };
+        let xpbd = XpbdIntegrator {
+            solver: Xpbd::new(),
+            params: XpbdParams::default(),
+        };
+        let flat = party.node_strain_errors(&cloth, &state);
+        assert!(flat.iter().all(|&e| e == 0.0), "flat sheet");
+        // Node 0 is a corner: its edges go to node 1 (along u) and node 9 (along v), 2.5 cm.
+        let rest = cloth.topology().rest_positions();
+        let h = rest[1][0] - rest[0][0];
+        assert!((h - 0.025).abs() < 1e-12, "{h}");
+        let stretch = 0.04;
+        state.positions[0].x -= stretch * h;
+        for integrator in [&party as &dyn Integrator, &xpbd] {
+            let e = integrator.node_strain_errors(&cloth, &state);
+            assert!((f64::from(e[0]) - stretch).abs() < 1e-6, "{}", e[0]);
+            assert!((f64::from(e[1]) - stretch).abs() < 1e-6, "{}", e[1]);
+            // The edge to node 9 turns but hardly lengthens: √(1 + 0.04²) − 1 = 8.0e-4.
+            assert!((f64::from(e[9]) - (1.0 + stretch * stretch).sqrt() + 1.0).abs() < 1e-6);
+            assert_eq!(e[40], 0.0, "an untouched node");
+        }
+        let mut party = party;
+        state.positions[0].x += stretch * h;
+        let report = party
+            .advance(&cloth, &mut state, StepInput::new(1e-3), &mut NoCollision)
+            .expect("step");
+        let e = party.node_strain_errors(&cloth, &state);
+        let largest = e.iter().copied().fold(0.0_f32, f32::max);
+        assert!(
+            (f64::from(largest) - report.max_strain_error).abs()
+                <= 1e-6 * report.max_strain_error.max(1e-9),
+            "{largest} vs {}",
+            report.max_strain_error
+        );
     }
 
     /// Stepping through the trait is stepping the integrator itself, Δt and gravity given per

@@ -44,6 +44,10 @@ enum Blob {
     /// Part, target (kept frame `target + 1`).
     TargetPositions(usize, usize),
     TargetNormals(usize, usize),
+    /// Part: its vertex colours.
+    Colours(usize),
+    /// Part, kept frame: its values per vertex.
+    Values(usize, usize),
     Times(usize),
     Weights(usize),
 }
@@ -134,6 +138,36 @@ fn check_animated<'p>(
     check_part(path, part, n)?;
     for (k, frame) in anim.frames.iter().enumerate() {
         check_frame(path, part, k, frame, n)?;
+    }
+    if let Some((colours, _)) = part.vertex_colours
+        && (colours.len() != n || colours.iter().flatten().any(|c| !c.is_finite()))
+    {
+        return Err(invalid_part(
+            path,
+            part,
+            format!(
+                "{} vertex colours for {n} vertices, or a colour not finite",
+                colours.len()
+            ),
+        ));
+    }
+    if let Some(v) = part.frame_values {
+        let bad = v.values.len() != anim.frames.len()
+            || v.values
+                .iter()
+                .any(|f| f.len() != n || f.iter().any(|x| !x.is_finite()));
+        if bad {
+            return Err(invalid_part(
+                path,
+                part,
+                format!(
+                    "{}: {} lists of values for {} frames of {n} vertices, or a value not finite",
+                    v.name,
+                    v.values.len(),
+                    anim.frames.len()
+                ),
+            ));
+        }
     }
     if let Some(k) = anim.times.iter().position(|t| !t.is_finite()) {
         return Err(invalid_part(
@@ -289,10 +323,33 @@ pub fn write_glb(
             "mode": TRIANGLES,
         });
         let mut mesh = json!({ "name": p.part.name });
+        let mut extras = serde_json::Map::new();
         if !targets.is_empty() {
             mesh["weights"] = json!(vec![0.0; targets.len()]);
-            mesh["extras"] = json!({ "targetNames": target_names });
+            extras.insert("targetNames".into(), json!(target_names));
             primitive["targets"] = json!(targets);
+        }
+        if let Some((_, names)) = p.part.vertex_colours {
+            primitive["attributes"]["COLOR_0"] =
+                json!(layout.add(Blob::Colours(i), FLOAT, "VEC3", n, Some(ARRAY_BUFFER), None,));
+            extras.insert("panels".into(), json!(names));
+        }
+        if let Some(values) = p.part.frame_values {
+            let accessors: Vec<usize> = (0..p.keep.len())
+                .map(|t| layout.add(Blob::Values(i, t), FLOAT, "SCALAR", n, None, None))
+                .collect();
+            let max = p
+                .keep
+                .iter()
+                .flat_map(|&k| &values.values[k])
+                .fold(0.0_f32, |m, &v| m.max(v));
+            extras.insert(
+                values.name.into(),
+                json!({ "accessors": accessors, "max": max }),
+            );
+        }
+        if !extras.is_empty() {
+            mesh["extras"] = Value::Object(extras);
         }
         mesh["primitives"] = json!([primitive]);
         meshes.push(mesh);
@@ -438,6 +495,19 @@ fn write_blob(
             let normals = vertex_normals(&p.anim.frames[p.keep[t + 1]], p.part.triangles);
             for (b, n) in p.base_normals.iter().zip(normals) {
                 put_f32s(w, delta(*b, n))?;
+            }
+        }
+        Blob::Colours(i) => {
+            let (colours, _) = glb[i].part.vertex_colours.expect("laid out with colours");
+            for c in colours {
+                put_f32s(w, c.map(srgb_to_linear))?;
+            }
+        }
+        Blob::Values(i, t) => {
+            let p = &glb[i];
+            let values = p.part.frame_values.expect("laid out with values");
+            for v in &values.values[p.keep[t]] {
+                w.write_all(&v.to_le_bytes())?;
             }
         }
         Blob::Times(s) => {

@@ -37,6 +37,23 @@ pub struct MeshPart<'a> {
     pub colour: [f32; 3],
     /// Whether both faces are drawn (glTF `doubleSided`): true for cloth, whose inside shows.
     pub double_sided: bool,
+    /// Per-vertex display (sRGB) colours with the names of what they mark (glTF `COLOR_0`,
+    /// linear, and `extras.panels`; the viewer's colouring by panel). glTF only.
+    pub vertex_colours: Option<(&'a [[f32; 3]], &'a [String])>,
+    /// A value per vertex per animation frame (glTF: one `SCALAR` accessor per kept frame,
+    /// listed with the largest value in the mesh's `extras` under the given name; the viewer's
+    /// colouring by strain error). glTF only; one list per frame of the animation, one value
+    /// per vertex, finite (else the export is refused).
+    pub frame_values: Option<FrameValues<'a>>,
+}
+
+/// A value per vertex for every frame of a part's [`Animation`].
+#[derive(Clone, Copy, Debug)]
+pub struct FrameValues<'a> {
+    /// The key in the mesh's `extras` (`strain_error`).
+    pub name: &'a str,
+    /// One list per frame, one value per vertex.
+    pub values: &'a [Vec<f32>],
 }
 
 impl<'a> MeshPart<'a> {
@@ -47,6 +64,8 @@ impl<'a> MeshPart<'a> {
             triangles,
             colour,
             double_sided: true,
+            vertex_colours: None,
+            frame_values: None,
         }
     }
 
@@ -57,6 +76,8 @@ impl<'a> MeshPart<'a> {
             triangles,
             colour,
             double_sided: false,
+            vertex_colours: None,
+            frame_values: None,
         }
     }
 }

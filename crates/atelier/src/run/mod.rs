@@ -328,6 +328,17 @@ fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
     let speed = run.final_rms_speed();
     let mut cloth = Animation::default();
     let mut body = Animation::default();
+    let strain_error: Vec<Vec<f32>> = run.frames.iter().map(|f| f.strain_error.clone()).collect();
+    let n = run.frames.first().map_or(0, |f| f.cloth.len());
+    let detail = crate::outcome::ClothDetail {
+        strain_error: if strain_error.iter().all(|s| s.len() == n) {
+            strain_error
+        } else {
+            Vec::new()
+        },
+        panels: run.panels.0.clone(),
+        node_panel: run.panels.1.clone(),
+    };
     for f in &run.frames {
         cloth.push(f.time, f.cloth.clone());
         body.push(f.time, f.body.clone());
@@ -410,6 +421,7 @@ fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
         failure: run.failure,
         outputs: KindOutputs::Cloth,
         convergence: Some(run.convergence),
+        detail,
     }
 }
 

@@ -13,7 +13,7 @@ use nalgebra::Vector3;
 use super::to_y_up;
 use crate::convergence::{Convergence, Tally, solvers};
 use crate::export::Animation;
-use crate::outcome::{DrapeTop, KindOutputs, RunError, Simulated, Solid};
+use crate::outcome::{ClothDetail, DrapeTop, KindOutputs, RunError, Simulated, Solid};
 use crate::scenario::{
     CantileverSpec, CatenarySpec, DrapeSpec, KesBendingSpec, KesTensileSpec, StripDirection, Tester,
 };
@@ -35,6 +35,8 @@ struct Stepper {
     tally: Tally,
     /// The shape tolerance of the steps.
     tolerance: f64,
+    /// Per recorded frame, each node's largest strain error (the viewer's colours).
+    strain: Vec<Vec<f32>>,
 }
 
 impl Stepper {
@@ -54,6 +56,7 @@ impl Stepper {
             last_good: state.positions.clone(),
             tally: Tally::default(),
             tolerance: StepParams::default().shape.tolerance,
+            strain: Vec::new(),
         }
     }
 
@@ -67,6 +70,11 @@ impl Stepper {
         input: StepInput,
     ) -> bool {
         self.last_good.copy_from_slice(&state.positions);
+        if self.strain.is_empty() {
+            // The first frame, before any step: against the rest lengths.
+            self.strain
+                .push(solver.node_strain_errors(cloth, state, params));
+        }
         let t = state.time;
         let clock = Instant::now();
         let result = solver.step(cloth, state, params, input);
@@ -85,6 +93,8 @@ impl Stepper {
                 if state.time + 1e-9 * input.dt >= self.next_frame {
                     self.frames
                         .push(state.time, state.positions.iter().map(to_y_up).collect());
+                    self.strain
+                        .push(solver.node_strain_errors(cloth, state, params));
                     self.next_frame += self.interval;
                 }
                 true
@@ -99,7 +109,7 @@ impl Stepper {
     }
 
     /// Record the final state unless it is the last frame already.
-    fn finish(&mut self, state: &ClothState) {
+    fn finish(&mut self, solver: &Solver, cloth: &Cloth, state: &ClothState, params: &StepParams) {
         if self
             .frames
             .times
@@ -108,6 +118,8 @@ impl Stepper {
         {
             self.frames
                 .push(state.time, state.positions.iter().map(to_y_up).collect());
+            self.strain
+                .push(solver.node_strain_errors(cloth, state, params));
         }
     }
 
@@ -126,6 +138,12 @@ impl Stepper {
             Some(state.kinetic_energy(cloth))
         };
         metrics.insert("kinetic_energy_j".into(), ke);
+        // Complete only when every frame has its values (a run of no step has none).
+        let strain = if self.strain.len() == self.frames.frames.len() {
+            self.strain
+        } else {
+            Vec::new()
+        };
         Simulated {
             fabric: String::new(),
             cloth_triangles: cloth.topology().triangles().to_vec(),
@@ -141,6 +159,10 @@ impl Stepper {
             failure: self.failure,
             outputs: KindOutputs::Cloth,
             convergence: Some(self.tally.convergence(self.tolerance)),
+            detail: ClothDetail {
+                strain_error: strain,
+                ..ClothDetail::default()
+            },
         }
     }
 }
@@ -184,7 +206,7 @@ pub(super) fn drape(
             break;
         }
     }
-    stepper.finish(&state);
+    stepper.finish(&solver, &cloth, &state, &params);
     let mut metrics = BTreeMap::new();
     let ok = stepper.failure.is_none();
     let m = scene.measure(&cloth, &state);
@@ -348,7 +370,7 @@ pub(super) fn cantilever(
             break;
         }
     }
-    stepper.finish(&state);
+    stepper.finish(&solver, &cloth, &state, &params);
     let tip = (state.positions[2 * (nv - 1)] + state.positions[2 * (nv - 1) + 1]) * 0.5;
     let angle = (-tip.z).atan2(tip.x).to_degrees();
     let ok = stepper.failure.is_none();
@@ -460,7 +482,7 @@ pub(super) fn catenary(
         }
         progress(state.time / spec.duration);
     }
-    stepper.finish(&state);
+    stepper.finish(&solver, &cloth, &state, &params);
     let ok = stepper.failure.is_none();
     let mut worst: f64 = 0.0;
     for p in &state.positions {
@@ -685,5 +707,6 @@ fn kes_simulated(
         failure: None,
         outputs: KindOutputs::Chart(chart),
         convergence: Some(Convergence::from_stats(solvers::PARTY, stats)),
+        detail: ClothDetail::default(),
     })
 }

@@ -5,12 +5,26 @@ use std::path::{Path, PathBuf};
 
 use super::{PictureStyle, RunOptions, outputs};
 use crate::export::{
-    Animation, ExportError, GlbOptions, MeshPart, write_glb, write_obj, write_ply,
+    Animation, ExportError, FrameValues, GlbOptions, MeshPart, write_glb, write_obj, write_ply,
 };
 use crate::outcome::{KindOutputs, RunError, Simulated};
 
 /// Colour of the cloth in exports and pictures.
 const CLOTH_COLOUR: [f32; 3] = [0.85, 0.35, 0.25];
+/// Colours of a garment's panels in `run.glb` (sRGB; Tableau 10, distinct for up to ten panels,
+/// then repeated).
+const PANEL_COLOURS: [[f32; 3]; 10] = [
+    [0.306, 0.475, 0.655],
+    [0.949, 0.557, 0.169],
+    [0.882, 0.341, 0.349],
+    [0.463, 0.718, 0.698],
+    [0.349, 0.631, 0.310],
+    [0.929, 0.788, 0.282],
+    [0.690, 0.478, 0.631],
+    [1.000, 0.616, 0.655],
+    [0.612, 0.459, 0.373],
+    [0.729, 0.690, 0.675],
+];
 /// Colour of the body or tester.
 const SOLID_COLOUR: [f32; 3] = [0.75, 0.75, 0.78];
 
@@ -73,7 +87,25 @@ pub(super) fn write_outputs(
     };
     export(outputs::OBJ, write_obj(&out.join(outputs::OBJ), &still))?;
     export(outputs::PLY, write_ply(&out.join(outputs::PLY), &still))?;
-    let mut animated: Vec<(MeshPart<'_>, &Animation)> = vec![(cloth_part, &sim.cloth)];
+    // run.glb also carries what the viewer colours the cloth by: its panels and, per frame,
+    // each node's strain error.
+    let panel_colours: Vec<[f32; 3]> = sim
+        .detail
+        .node_panel
+        .iter()
+        .map(|&p| PANEL_COLOURS[p as usize % PANEL_COLOURS.len()])
+        .collect();
+    let mut cloth_glb = cloth_part;
+    if !panel_colours.is_empty() {
+        cloth_glb.vertex_colours = Some((&panel_colours, &sim.detail.panels));
+    }
+    if !sim.detail.strain_error.is_empty() {
+        cloth_glb.frame_values = Some(FrameValues {
+            name: "strain_error",
+            values: &sim.detail.strain_error,
+        });
+    }
+    let mut animated: Vec<(MeshPart<'_>, &Animation)> = vec![(cloth_glb, &sim.cloth)];
     if let Some((part, s)) = &solid_part {
         animated.push((*part, &s.motion));
     }

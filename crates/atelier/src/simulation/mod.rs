@@ -297,6 +297,27 @@ impl Simulation {
         &self.state
     }
 
+    /// Each cloth node's largest axial strain error in the current state (the integrator's
+    /// [`Integrator::node_strain_errors`]): what the viewer colours the cloth by.
+    pub fn node_strain_errors(&self) -> Vec<f32> {
+        self.integrator
+            .node_strain_errors(&self.scene.garment.cloth.cloth, &self.state)
+    }
+
+    /// The garment's panel names and the panel of each cloth node.
+    pub fn node_panels(&self) -> (Vec<String>, Vec<u16>) {
+        let cloth = &self.scene.garment.cloth;
+        let n = self.state.positions.len();
+        let mut of_node = vec![0_u16; n];
+        for (k, w) in cloth.offsets.iter().enumerate() {
+            let end = cloth.offsets.get(k + 1).map_or(n, |&e| e as usize);
+            for p in &mut of_node[(*w as usize).min(n)..end.min(n)] {
+                *p = k as u16;
+            }
+        }
+        (cloth.panel_names.clone(), of_node)
+    }
+
     /// The phase the next step belongs to.
     pub fn phase(&self) -> Phase {
         self.phase

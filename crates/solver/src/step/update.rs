@@ -204,20 +204,59 @@ impl Solver {
         state: &ClothState,
         params: &StepParams,
     ) -> f64 {
+        self.axial_strain_errors(cloth, state, params)
+            .map(|(_, err)| err)
+            .fold(0.0, f64::max)
+    }
+
+    /// Each axial edge with its strain error |ε − ε̄| against the target length ε̄ of the last
+    /// step (stretch-only edges: excess stretch only); before the first step, against the rest
+    /// length.
+    fn axial_strain_errors<'a>(
+        &'a self,
+        cloth: &'a Cloth,
+        state: &'a ClothState,
+        params: &'a StepParams,
+    ) -> impl Iterator<Item = (u32, f64)> + 'a {
         let edges = cloth.topology().edges();
         let pos = &state.positions;
-        cloth
-            .axial_edge_list()
-            .iter()
-            .map(|&e| {
-                let edge = &edges[e as usize];
-                let l = (pos[edge.b as usize] - pos[edge.a as usize]).norm();
-                let err = (l - self.s.target[e as usize]) / edge.rest_length;
-                match params.shape.axial_constraint {
-                    ConstraintKind::Equality => err.abs(),
-                    ConstraintKind::StretchOnly => err.max(0.0),
-                }
-            })
-            .fold(0.0, f64::max)
+        let stepped = self.s.target.len() == edges.len();
+        cloth.axial_edge_list().iter().map(move |&e| {
+            let edge = &edges[e as usize];
+            let l = (pos[edge.b as usize] - pos[edge.a as usize]).norm();
+            let target = if stepped {
+                self.s.target[e as usize]
+            } else {
+                edge.rest_length
+            };
+            let err = (l - target) / edge.rest_length;
+            let err = match params.shape.axial_constraint {
+                ConstraintKind::Equality => err.abs(),
+                ConstraintKind::StretchOnly => err.max(0.0),
+            };
+            (e, err)
+        })
+    }
+
+    /// Per node, the largest strain error of its axial edges (as [`StepReport`]'s
+    /// `max_strain_error`, whose largest value this is): what a viewer colours the cloth by.
+    ///
+    /// [`StepReport`]: crate::StepReport
+    pub fn node_strain_errors(
+        &self,
+        cloth: &Cloth,
+        state: &ClothState,
+        params: &StepParams,
+    ) -> Vec<f32> {
+        let edges = cloth.topology().edges();
+        let mut out = vec![0.0_f32; state.positions.len()];
+        for (e, err) in self.axial_strain_errors(cloth, state, params) {
+            let edge = &edges[e as usize];
+            for n in [edge.a, edge.b] {
+                let v = &mut out[n as usize];
+                *v = v.max(err as f32);
+            }
+        }
+        out
     }
 }
