@@ -1,7 +1,7 @@
 //! Pictures without a GPU: a small orthographic z-buffer renderer (no maintained
-//! software-rasteriser crate fits, see `dependencies.md`) — flat-shaded triangles coloured per
-//! triangle, seen from the front, the back or the body's left side, scaled to fit — and PNG
-//! output written atomically. The figure sets of `xtask` and the pipeline's pictures use it.
+//! software-rasteriser crate fits, see `dependencies.md`) — triangles coloured per triangle and
+//! smooth-shaded (vertex normals interpolated at each pixel), seen from the front, the back or
+//! the body's left side, scaled to fit — and PNG output written atomically. The figure sets of `xtask` and the pipeline's pictures use it.
 
 use std::path::Path;
 
@@ -64,8 +64,8 @@ pub fn screen_box(points: &[[f64; 3]], view: View) -> ([f64; 2], [f64; 2]) {
     (lo, hi)
 }
 
-/// Render: RGB per pixel (`None` = background), `w × h`, row 0 at the top. Each triangle is
-/// shaded by how squarely it faces the viewer.
+/// Render: RGB per pixel (`None` = background), `w × h`, row 0 at the top, shaded by how
+/// squarely the surface faces the viewer (smooth: see [`render_lit`]).
 pub fn render(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -79,8 +79,13 @@ pub fn render(
 }
 
 /// [`render`] with a light: with `light` (a direction in the view's frame — screen x right,
-/// y up, z towards the viewer — pointing towards the light) a triangle's shade is
+/// y up, z towards the viewer — pointing towards the light) the shade is
 /// `0.3 + 0.7 · max(0, n · l)`; without, `0.25 + 0.75 · n_z` (lit from the viewer).
+///
+/// Smooth shading: `n` is the vertex normals interpolated at the pixel (Phong). A vertex's
+/// normal sums the area-weighted normals of the triangles that face the viewer, so a cloth
+/// drawn two-sided (each triangle also reversed) gets the normal of the side that shows, and the
+/// two copies do not cancel.
 pub fn render_lit(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -91,28 +96,58 @@ pub fn render_lit(
     light: Option<[f64; 3]>,
 ) -> Vec<Option<[f64; 3]>> {
     let view_points: Vec<[f64; 3]> = positions.iter().map(|&p| to_view(p, view)).collect();
-    let ids = rasterise(&view_points, triangles, fit, w, h);
-    // One colour per triangle, shaded (the pixels look them up).
-    let rgb: Vec<[f64; 3]> = triangles
-        .iter()
-        .enumerate()
-        .map(|(t, tri)| {
-            let shade = triangle_shade(tri.map(|k| view_points[k as usize]), light);
-            colour(t).map(|v| v * shade)
+    let hits = rasterise_weighted(&view_points, triangles, fit, w, h);
+    let normals = facing_vertex_normals(&view_points, triangles);
+    let colours: Vec<[f64; 3]> = (0..triangles.len()).map(colour).collect();
+    hits.iter()
+        .map(|hit| {
+            hit.map(|(t, l)| {
+                let tri = triangles[t as usize];
+                let mut n = [0.0; 3];
+                for (k, &v) in tri.iter().enumerate() {
+                    for (c, m) in n.iter_mut().zip(normals[v as usize]) {
+                        *c += l[k] * m;
+                    }
+                }
+                colours[t as usize].map(|v| v * normal_shade(n, light))
+            })
         })
-        .collect();
-    ids.iter().map(|id| id.map(|t| rgb[t as usize])).collect()
+        .collect()
+}
+
+/// Per vertex (in a view's frame), the sum of the area-weighted normals of the triangles that
+/// face the viewer; zero where none does.
+fn facing_vertex_normals(view_points: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 3]> {
+    let mut normals = vec![[0.0; 3]; view_points.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|k| view_points[k as usize]);
+        let n = cross(sub(b, a), sub(c, a));
+        if n[2] > 0.0 && n.iter().all(|v| v.is_finite()) {
+            for &k in t {
+                let m = &mut normals[k as usize];
+                for (mi, ni) in m.iter_mut().zip(n) {
+                    *mi += ni;
+                }
+            }
+        }
+    }
+    normals
+}
+
+/// The shade of a surface whose normal is `n` (any length, view frame), as [`render_lit`]
+/// draws it: lit by `light` (any length; towards the light), or from the viewer without one.
+pub fn normal_shade(n: [f64; 3], light: Option<[f64; 3]>) -> f64 {
+    let len = dot(n, n).sqrt().max(1e-300);
+    match light {
+        None => 0.25 + 0.75 * (n[2] / len).max(0.0),
+        Some(l) => 0.3 + 0.7 * (dot(n, l) / (len * dot(l, l).sqrt().max(1e-300))).max(0.0),
+    }
 }
 
 /// The shade of a triangle (corners in a view's frame) as [`render_lit`] draws it: lit by
 /// `light` (any length; towards the light), or from the viewer without one.
 pub fn triangle_shade([a, b, c]: [[f64; 3]; 3], light: Option<[f64; 3]>) -> f64 {
-    let n = cross(sub(b, a), sub(c, a));
-    let len = dot(n, n).sqrt().max(1e-300);
-    match light {
-        None => 0.25 + 0.75 * n[2] / len,
-        Some(l) => 0.3 + 0.7 * (dot(n, l) / (len * dot(l, l).sqrt().max(1e-300))).max(0.0),
-    }
+    normal_shade(cross(sub(b, a), sub(c, a)), light)
 }
 
 /// The front-most triangle at each pixel centre (`None`: nothing), `w × h`, row 0 at the top,
@@ -125,6 +160,21 @@ pub fn rasterise(
     w: usize,
     h: usize,
 ) -> Vec<Option<u32>> {
+    rasterise_weighted(view_points, triangles, fit, w, h)
+        .into_iter()
+        .map(|hit| hit.map(|(t, _)| t))
+        .collect()
+}
+
+/// [`rasterise`] with the pixel centre's barycentric weights in its triangle (the weights of
+/// the triangle's corners, in order; they sum to 1).
+pub fn rasterise_weighted(
+    view_points: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    fit: Fit,
+    w: usize,
+    h: usize,
+) -> Vec<Option<(u32, [f64; 3])>> {
     let mut depth = vec![f64::NEG_INFINITY; w * h];
     let mut out = vec![None; w * h];
     if w == 0 || h == 0 {
@@ -172,7 +222,7 @@ pub fn rasterise(
                 let k = y * w + x;
                 if z > depth[k] {
                     depth[k] = z;
-                    out[k] = Some(ti as u32);
+                    out[k] = Some((ti as u32, l));
                 }
             }
         }
@@ -397,4 +447,106 @@ pub fn wet_views(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A UV sphere of radius `r`, `rings` × `segments`, outward triangles.
+    fn sphere(r: f64, rings: usize, segments: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut points = vec![[0.0, r, 0.0]];
+        for i in 1..rings {
+            let theta = std::f64::consts::PI * i as f64 / rings as f64;
+            for j in 0..segments {
+                let phi = std::f64::consts::TAU * j as f64 / segments as f64;
+                points.push([
+                    r * theta.sin() * phi.cos(),
+                    r * theta.cos(),
+                    -r * theta.sin() * phi.sin(),
+                ]);
+            }
+        }
+        points.push([0.0, -r, 0.0]);
+        let south = (points.len() - 1) as u32;
+        let at = |i: usize, j: usize| (1 + (i - 1) * segments + j % segments) as u32;
+        let mut tris = Vec::new();
+        for j in 0..segments {
+            tris.push([0, at(1, j), at(1, j + 1)]);
+            tris.push([south, at(rings - 1, j + 1), at(rings - 1, j)]);
+        }
+        for i in 1..rings - 1 {
+            for j in 0..segments {
+                tris.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                tris.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        (points, tris)
+    }
+
+    /// A sphere seen from the front is lit from the viewer as `0.25 + 0.75·n_z` with the exact
+    /// normal n_z = √(1 − ρ²) at distance ρ (in radii) from the centre of its disc. The smooth
+    /// render meets it within 1 % over the inner 90 % of the radius (a 24 × 48 sphere); flat
+    /// shading, one shade per facet, misses it by several times more.
+    #[test]
+    fn a_smooth_shaded_sphere_matches_the_exact_normals() {
+        let (points, tris) = sphere(1.0, 24, 48);
+        let (w, h) = (200, 200);
+        let fit = Fit::new([-1.05, -1.05], [1.05, 1.05], w, h);
+        let white = |_| [1.0, 1.0, 1.0];
+        let smooth = render(&points, &tris, &white, View::Front, fit, w, h);
+        let view: Vec<[f64; 3]> = points.iter().map(|&p| to_view(p, View::Front)).collect();
+        let ids = rasterise(&view, &tris, fit, w, h);
+        let (mut worst_smooth, mut worst_flat, mut counted) = (0.0_f64, 0.0_f64, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let sx = (x as f64 + 0.5 - 0.5 * w as f64) / fit.scale;
+                let sy = (0.5 * h as f64 - y as f64 - 0.5) / fit.scale;
+                let rho = sx.hypot(sy);
+                if rho > 0.9 {
+                    continue;
+                }
+                let exact = 0.25 + 0.75 * (1.0 - rho * rho).sqrt();
+                let k = y * w + x;
+                let s = smooth[k].expect("inside the disc")[0];
+                let t = ids[k].expect("inside the disc") as usize;
+                let flat = triangle_shade(tris[t].map(|v| view[v as usize]), None);
+                worst_smooth = worst_smooth.max((s - exact).abs());
+                worst_flat = worst_flat.max((flat - exact).abs());
+                counted += 1;
+            }
+        }
+        assert!(counted > 20_000, "{counted}");
+        assert!(worst_smooth < 0.01, "smooth {worst_smooth}");
+        assert!(
+            worst_flat > 3.0 * worst_smooth,
+            "flat {worst_flat}, smooth {worst_smooth}"
+        );
+    }
+
+    /// A sheet drawn two-sided (each triangle also reversed, as the garment pictures do) is
+    /// shaded by the normal of the side that shows: the copies facing away neither show nor
+    /// cancel the vertex normals.
+    #[test]
+    fn a_two_sided_sheet_shows_the_side_facing_the_viewer() {
+        let points = [
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+        ];
+        let front = [[0, 1, 2], [0, 2, 3]];
+        let both: Vec<[u32; 3]> = front
+            .iter()
+            .copied()
+            .chain(front.iter().map(|t| [t[0], t[2], t[1]]))
+            .collect();
+        let fit = Fit::new([-1.2, -1.2], [1.2, 1.2], 40, 40);
+        for view in [View::Front, View::Back] {
+            let px = render(&points, &both, &|_| [1.0; 3], view, fit, 40, 40);
+            let lit: Vec<f64> = px.iter().flatten().map(|c| c[0]).collect();
+            assert!(lit.len() > 1000, "{view:?}: {}", lit.len());
+            assert!(lit.iter().all(|&s| (s - 1.0).abs() < 1e-12), "{view:?}");
+        }
+    }
 }
