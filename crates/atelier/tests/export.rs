@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use atelier::export::{
     Animation, ExportError, FrameSelection, FrameValues, GlbOptions, Interpolation, MeshPart,
-    write_glb, write_obj, write_ply,
+    VertexColours, write_glb, write_obj, write_ply,
 };
 use serde_json::Value;
 
@@ -428,7 +428,11 @@ fn glb_carries_vertex_colours_and_values_per_kept_frame_for_the_viewer() {
         .map(|k| (0..4).map(|v| (10 * k + v) as f32 * 1e-3).collect())
         .collect();
     let mut cloth_p = cloth_part();
-    cloth_p.vertex_colours = Some((&colours, &names));
+    cloth_p.vertex_colours = Some(VertexColours {
+        colours: &colours,
+        names: &names,
+        name_colours: &[[0.0, 0.5, 1.0], [1.0, 0.0, 0.0]],
+    });
     cloth_p.frame_values = Some(FrameValues {
         name: "strain_error",
         values: &values,
@@ -444,6 +448,15 @@ fn glb_carries_vertex_colours_and_values_per_kept_frame_for_the_viewer() {
     assert_eq!(
         mesh["extras"]["panels"],
         serde_json::json!(["front", "back"])
+    );
+    let given: Vec<f32> = as_f32s(&mesh["extras"]["panel_colours"][0]);
+    assert!(
+        (given[1] - 0.214_041_14).abs() < 1e-6,
+        "linear, as COLOR_0: {given:?}"
+    );
+    assert_eq!(
+        as_f32s(&mesh["extras"]["panel_colours"][1]),
+        [1.0, 0.0, 0.0]
     );
     let colour = mesh["primitives"][0]["attributes"]["COLOR_0"]
         .as_u64()

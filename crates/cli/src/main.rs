@@ -6,6 +6,8 @@
 //! - `atelier validate FILE…`: check data files.
 //! - `atelier pattern FILE.dxf|FILE.svg --out DIR [--cell CM]`: pattern pieces from pattern software or
 //!   apparel CAD as atelier patterns, grids and a picture.
+//! - `atelier view DIR [--serve [PORT]]`: a finished run folder as a web page (3-D, time slider,
+//!   the report), opened from the files or served on 127.0.0.1.
 //! - `atelier tryon --photo P.png [--mask M.png] --garment G.ron [--pose S.ron] --out DIR`:
 //!   virtual try-on from one photograph.
 //!
@@ -15,6 +17,7 @@
 //! one line on stderr, never a backtrace.
 
 mod validate;
+mod view;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -121,6 +124,17 @@ enum Command {
         #[arg(long, default_value_t = 2.0)]
         cell: f64,
     },
+    /// Write DIR/index.html (and its assets, and viewer-data.js with the run) for a finished run
+    /// folder: the run in 3-D with a time slider, and its report (docs/viewer.md). Open the page
+    /// from the disk, or give --serve to serve the folder on 127.0.0.1.
+    View {
+        /// The run folder (what `atelier run --out DIR` wrote).
+        dir: PathBuf,
+        /// Serve the folder on 127.0.0.1 at PORT (default 8000; 0 picks a free port) and print
+        /// the address; runs until stopped (Ctrl-C).
+        #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "8000")]
+        serve: Option<u16>,
+    },
     /// Check fabric, pattern, garment, body, motion, range side, scenario and try-on pose files (RON) and
     /// body meshes (OBJ, PLY); print each problem with file:line:column and field.
     Validate {
@@ -190,6 +204,7 @@ fn main() -> ExitCode {
             }
         },
         Some(Command::Validate { files }) => validate(&files),
+        Some(Command::View { dir, serve }) => view(&dir, serve),
         Some(Command::Pattern { file, out, cell }) => pattern(&file, &out, cell),
         Some(Command::Tryon {
             photo,
@@ -280,6 +295,44 @@ fn run_scenario(
             eprintln!("atelier: {}: {e}", scenario.name);
             ExitCode::FAILURE
         }
+    }
+}
+
+/// `atelier view`: the page, each problem on stderr first; then, with `--serve`, the server.
+/// Exit status 1 when the page could not be written or the port not opened, 2 when the page
+/// was written but the folder lacks or breaks a file the page shows.
+fn view(dir: &Path, serve: Option<u16>) -> ExitCode {
+    let page = match view::write_page(dir) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("atelier: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    for p in &page.problems {
+        eprintln!("atelier: {}: {p}", dir.display());
+    }
+    // The page's address is the program's output.
+    #[allow(clippy::print_stdout)]
+    {
+        println!("wrote {}", page.index.display());
+    }
+    if let Some(port) = serve {
+        let served = view::serve(dir, port, |address| {
+            #[allow(clippy::print_stdout)]
+            {
+                println!("serving {} at {address} (Ctrl-C stops)", dir.display());
+            }
+        });
+        if let Err(e) = served {
+            eprintln!("atelier: cannot serve on 127.0.0.1:{port}: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    if page.problems.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(2)
     }
 }
 

@@ -139,15 +139,24 @@ fn check_animated<'p>(
     for (k, frame) in anim.frames.iter().enumerate() {
         check_frame(path, part, k, frame, n)?;
     }
-    if let Some((colours, _)) = part.vertex_colours
-        && (colours.len() != n || colours.iter().flatten().any(|c| !c.is_finite()))
+    if let Some(vc) = part.vertex_colours
+        && (vc.colours.len() != n
+            || vc.names.len() != vc.name_colours.len()
+            || vc
+                .colours
+                .iter()
+                .chain(vc.name_colours)
+                .flatten()
+                .any(|c| !c.is_finite()))
     {
         return Err(invalid_part(
             path,
             part,
             format!(
-                "{} vertex colours for {n} vertices, or a colour not finite",
-                colours.len()
+                "{} vertex colours for {n} vertices, {} names for {} group colours, or a colour not finite",
+                vc.colours.len(),
+                vc.names.len(),
+                vc.name_colours.len()
             ),
         ));
     }
@@ -329,10 +338,17 @@ pub fn write_glb(
             extras.insert("targetNames".into(), json!(target_names));
             primitive["targets"] = json!(targets);
         }
-        if let Some((_, names)) = p.part.vertex_colours {
+        if let Some(vc) = p.part.vertex_colours {
             primitive["attributes"]["COLOR_0"] =
                 json!(layout.add(Blob::Colours(i), FLOAT, "VEC3", n, Some(ARRAY_BUFFER), None,));
-            extras.insert("panels".into(), json!(names));
+            extras.insert("panels".into(), json!(vc.names));
+            // Linear, as COLOR_0.
+            let linear: Vec<[f32; 3]> = vc
+                .name_colours
+                .iter()
+                .map(|c| c.map(srgb_to_linear))
+                .collect();
+            extras.insert("panel_colours".into(), json!(linear));
         }
         if let Some(values) = p.part.frame_values {
             let accessors: Vec<usize> = (0..p.keep.len())
@@ -498,8 +514,8 @@ fn write_blob(
             }
         }
         Blob::Colours(i) => {
-            let (colours, _) = glb[i].part.vertex_colours.expect("laid out with colours");
-            for c in colours {
+            let vc = glb[i].part.vertex_colours.expect("laid out with colours");
+            for c in vc.colours {
                 put_f32s(w, c.map(srgb_to_linear))?;
             }
         }

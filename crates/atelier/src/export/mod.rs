@@ -37,14 +37,26 @@ pub struct MeshPart<'a> {
     pub colour: [f32; 3],
     /// Whether both faces are drawn (glTF `doubleSided`): true for cloth, whose inside shows.
     pub double_sided: bool,
-    /// Per-vertex display (sRGB) colours with the names of what they mark (glTF `COLOR_0`,
-    /// linear, and `extras.panels`; the viewer's colouring by panel). glTF only.
-    pub vertex_colours: Option<(&'a [[f32; 3]], &'a [String])>,
+    /// Per-vertex display (sRGB) colours marking named groups (glTF `COLOR_0`, linear, and
+    /// `extras.panels` and `extras.panel_colours`, linear too; the viewer's colouring by panel).
+    /// glTF only.
+    pub vertex_colours: Option<VertexColours<'a>>,
     /// A value per vertex per animation frame (glTF: one `SCALAR` accessor per kept frame,
     /// listed with the largest value in the mesh's `extras` under the given name; the viewer's
     /// colouring by strain error). glTF only; one list per frame of the animation, one value
     /// per vertex, finite (else the export is refused).
     pub frame_values: Option<FrameValues<'a>>,
+}
+
+/// Per-vertex colours marking named groups of vertices (a garment's panels).
+#[derive(Clone, Copy, Debug)]
+pub struct VertexColours<'a> {
+    /// Display (sRGB) colour of each vertex.
+    pub colours: &'a [[f32; 3]],
+    /// The groups' names.
+    pub names: &'a [String],
+    /// The display (sRGB) colour of each group, as its vertices have it.
+    pub name_colours: &'a [[f32; 3]],
 }
 
 /// A value per vertex for every frame of a part's [`Animation`].

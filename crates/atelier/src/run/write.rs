@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use super::{PictureStyle, RunOptions, outputs};
 use crate::export::{
-    Animation, ExportError, FrameValues, GlbOptions, MeshPart, write_glb, write_obj, write_ply,
+    Animation, ExportError, FrameValues, GlbOptions, MeshPart, VertexColours, write_glb, write_obj,
+    write_ply,
 };
 use crate::outcome::{KindOutputs, RunError, Simulated};
 
@@ -95,9 +96,16 @@ pub(super) fn write_outputs(
         .iter()
         .map(|&p| PANEL_COLOURS[p as usize % PANEL_COLOURS.len()])
         .collect();
+    let name_colours: Vec<[f32; 3]> = (0..sim.detail.panels.len())
+        .map(|p| PANEL_COLOURS[p % PANEL_COLOURS.len()])
+        .collect();
     let mut cloth_glb = cloth_part;
     if !panel_colours.is_empty() {
-        cloth_glb.vertex_colours = Some((&panel_colours, &sim.detail.panels));
+        cloth_glb.vertex_colours = Some(VertexColours {
+            colours: &panel_colours,
+            names: &sim.detail.panels,
+            name_colours: &name_colours,
+        });
     }
     if !sim.detail.strain_error.is_empty() {
         cloth_glb.frame_values = Some(FrameValues {
