@@ -516,6 +516,9 @@ mod tests {
                 counted += 1;
             }
         }
+        eprintln!(
+            "sphere: worst smooth {worst_smooth:.5}, worst flat {worst_flat:.5} over {counted} pixels"
+        );
         assert!(counted > 20_000, "{counted}");
         assert!(worst_smooth < 0.01, "smooth {worst_smooth}");
         assert!(
