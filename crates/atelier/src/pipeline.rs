@@ -10,7 +10,84 @@ use serde::{Deserialize, Serialize};
 
 use crate::convergence::{Convergence, Tally, solvers};
 use crate::scene::{ClothSolver, GarmentSpec, Scene, SceneError};
-use crate::simulation::{Phase, Simulation, Timings};
+use crate::simulation::{Phase, Simulation, StepOutcome, Timings};
+
+/// What the steps of a garment run measured so far, step by step: what `report.json`'s garment
+/// metrics and convergence read. [`run_scene`] keeps one; so does a caller stepping a
+/// [`Simulation`] itself (the Python bindings), so both count alike.
+#[derive(Clone, Debug)]
+pub struct StepStats {
+    /// `None` for PARTY (whose steps report convergence), else the baseline's name.
+    pub baseline: Option<&'static str>,
+    /// The shape tolerance of the steps.
+    pub tolerance: f64,
+    /// The convergence of PARTY's steps.
+    pub tally: Tally,
+    /// Steps taken.
+    pub steps: usize,
+    /// Largest strain error any step left, and the last step's.
+    pub max_strain_error: (f64, f64),
+    /// Kinetic energy after the last step, J.
+    pub kinetic_energy: f64,
+    /// Largest kinetic energy over the motion phase, J.
+    pub max_motion_energy: f64,
+    /// Deepest any node went inside the body, m (the push not counted).
+    pub max_penetration: f64,
+    /// Steps after which some node was inside the body (the push not counted).
+    pub steps_with_penetration: usize,
+    /// Nodes inside the body after the last step.
+    pub inside: usize,
+}
+
+impl StepStats {
+    /// Nothing counted yet, for the scene's solver.
+    pub fn new(scene: &Scene) -> Self {
+        Self {
+            baseline: match &scene.settings.solver {
+                ClothSolver::Party => None,
+                ClothSolver::Xpbd(_) => Some(solvers::XPBD),
+                ClothSolver::MassSpring(_) => Some(solvers::MASS_SPRING),
+            },
+            tolerance: scene.settings.step.shape.tolerance,
+            tally: Tally::default(),
+            steps: 0,
+            max_strain_error: (0.0, 0.0),
+            kinetic_energy: 0.0,
+            max_motion_energy: 0.0,
+            max_penetration: 0.0,
+            steps_with_penetration: 0,
+            inside: 0,
+        }
+    }
+
+    /// Count one step that started at `start_time`.
+    pub fn add(&mut self, outcome: &StepOutcome, start_time: f64) {
+        self.steps += 1;
+        let r = &outcome.report;
+        if self.baseline.is_none() {
+            self.tally.add(r, start_time, Some(outcome.phase));
+        }
+        self.max_strain_error.0 = self.max_strain_error.0.max(r.max_strain_error);
+        self.max_strain_error.1 = r.max_strain_error;
+        self.kinetic_energy = r.kinetic_energy;
+        if outcome.phase == Phase::Motion {
+            self.max_motion_energy = self.max_motion_energy.max(r.kinetic_energy);
+        }
+        self.inside = outcome.inside;
+        if outcome.phase != Phase::Pushing {
+            self.max_penetration = self.max_penetration.max(outcome.depth);
+            self.steps_with_penetration += usize::from(outcome.inside > 0);
+        }
+    }
+
+    /// Whether the steps converged (a baseline: not reported).
+    pub fn convergence(&self) -> Convergence {
+        match self.baseline {
+            None => self.tally.convergence(self.tolerance),
+            Some(name) => Convergence::not_reported(name, self.steps),
+        }
+    }
+}
 
 /// One recorded instant.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -136,13 +213,7 @@ pub fn run_garment(
 /// [`run_garment`] on a scene already set up (the try-on builds its own body and motion).
 pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentRun, SceneError> {
     let frame_interval = scene.settings.frame_interval;
-    let baseline = match &scene.settings.solver {
-        ClothSolver::Party => None,
-        ClothSolver::Xpbd(_) => Some(solvers::XPBD),
-        ClothSolver::MassSpring(_) => Some(solvers::MASS_SPRING),
-    };
-    let tolerance = scene.settings.step.shape.tolerance;
-    let mut tally = Tally::default();
+    let mut stats = StepStats::new(&scene);
     let mut sim = Simulation::new(scene)?;
     let to3 = |v: &[atelier_collide::V3]| -> Vec<[f64; 3]> {
         v.iter().map(|p| [p.x, p.y, p.z]).collect()
@@ -173,23 +244,8 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
                 break;
             }
         };
-        run.steps += 1;
         run.timings.add(&outcome.timings);
-        let r = &outcome.report;
-        if baseline.is_none() {
-            tally.add(r, start_time, Some(outcome.phase));
-        }
-        run.max_strain_error.0 = run.max_strain_error.0.max(r.max_strain_error);
-        run.max_strain_error.1 = r.max_strain_error;
-        run.kinetic_energy = r.kinetic_energy;
-        if outcome.phase == Phase::Motion {
-            run.max_motion_energy = run.max_motion_energy.max(r.kinetic_energy);
-        }
-        run.inside_at_end = outcome.inside;
-        if outcome.phase != Phase::Pushing {
-            run.max_penetration = run.max_penetration.max(outcome.depth);
-            run.steps_with_penetration += usize::from(outcome.inside > 0);
-        }
+        stats.add(&outcome, start_time);
         if sim.time() + 1e-9 >= next_frame {
             run.frames.push(frame(&sim));
             next_frame += frame_interval;
@@ -201,10 +257,14 @@ pub fn run_scene(scene: Scene, progress: &mut dyn FnMut(f64)) -> Result<GarmentR
     run.sewn_at = sim.sewn_at();
     run.warnings = sim.warnings().to_vec();
     run.panels = sim.node_panels();
-    run.convergence = match baseline {
-        None => tally.convergence(tolerance),
-        Some(name) => Convergence::not_reported(name, run.steps),
-    };
+    run.steps = stats.steps;
+    run.max_strain_error = stats.max_strain_error;
+    run.kinetic_energy = stats.kinetic_energy;
+    run.max_motion_energy = stats.max_motion_energy;
+    run.inside_at_end = stats.inside;
+    run.max_penetration = stats.max_penetration;
+    run.steps_with_penetration = stats.steps_with_penetration;
+    run.convergence = stats.convergence();
     let last_time = run.frames.last().map_or(-1.0, |f| f.time);
     if (sim.time() - last_time).abs() > 1e-12 {
         run.frames.push(frame(&sim));

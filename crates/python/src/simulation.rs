@@ -6,9 +6,9 @@
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 
-use atelier::convergence::{Tally, solvers};
+use atelier::pipeline::StepStats;
 use atelier::scenario::{Scenario, ScenarioKind};
-use atelier::{ClothSolver, Phase, Scene, Simulation, StepOutcome};
+use atelier::{Scene, Simulation, StepOutcome};
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use serde_json::{Value, json};
@@ -39,18 +39,8 @@ pub struct PySimulation {
 /// counts them for report.json).
 struct Inner {
     sim: Simulation,
-    /// `None` for PARTY (which reports convergence), else the baseline's name.
-    baseline: Option<&'static str>,
-    tolerance: f64,
-    tally: Tally,
-    steps: usize,
-    max_strain_error: f64,
-    last_strain_error: f64,
-    kinetic_energy: f64,
-    max_motion_energy: f64,
-    max_penetration: f64,
-    steps_with_penetration: usize,
-    inside: usize,
+    /// Counted as `atelier run` counts them.
+    stats: StepStats,
     failure: Option<String>,
     ended: bool,
 }
@@ -65,22 +55,7 @@ impl Inner {
         let start = self.sim.time();
         match self.sim.step() {
             Ok(Some(o)) => {
-                self.steps += 1;
-                let r = &o.report;
-                if self.baseline.is_none() {
-                    self.tally.add(r, start, Some(o.phase));
-                }
-                self.max_strain_error = self.max_strain_error.max(r.max_strain_error);
-                self.last_strain_error = r.max_strain_error;
-                self.kinetic_energy = r.kinetic_energy;
-                if o.phase == Phase::Motion {
-                    self.max_motion_energy = self.max_motion_energy.max(r.kinetic_energy);
-                }
-                self.inside = o.inside;
-                if o.phase != Phase::Pushing {
-                    self.max_penetration = self.max_penetration.max(o.depth);
-                    self.steps_with_penetration += usize::from(o.inside > 0);
-                }
+                self.stats.add(&o, start);
                 Ok(Some(o))
             }
             Ok(None) => {
@@ -125,10 +100,8 @@ impl Inner {
                 / state.velocities.len() as f64)
                 .sqrt()
         });
-        let convergence = match self.baseline {
-            None => self.tally.convergence(self.tolerance),
-            Some(b) => atelier::convergence::Convergence::not_reported(b, self.steps),
-        };
+        let stats = &self.stats;
+        let convergence = stats.convergence();
         let mut warnings = sim.warnings().to_vec();
         warnings.extend(convergence.warning());
         json!({
@@ -137,7 +110,7 @@ impl Inner {
             "time_s": sim.time(),
             "phase": format!("{:?}", sim.phase()),
             "ended": self.ended,
-            "steps": self.steps,
+            "steps": stats.steps,
             "dt_s": sim.scene().settings.dt,
             "planned_s": sim.planned_time(),
             "sewing": {"pairs_sewn": sewn, "pairs": pairs, "sewn_at_s": sim.sewn_at()},
@@ -152,13 +125,13 @@ impl Inner {
                 "pairs_sewn": sewn,
                 "unsewn_pairs": pairs.saturating_sub(sewn),
                 "sewn_at_s": sim.sewn_at(),
-                "max_penetration_m": self.max_penetration,
-                "steps_with_penetration": self.steps_with_penetration,
-                "nodes_inside": self.inside,
-                "max_strain_error": self.max_strain_error,
-                "final_strain_error": self.last_strain_error,
-                "kinetic_energy_j": self.kinetic_energy,
-                "max_motion_kinetic_energy_j": self.max_motion_energy,
+                "max_penetration_m": stats.max_penetration,
+                "steps_with_penetration": stats.steps_with_penetration,
+                "nodes_inside": stats.inside,
+                "max_strain_error": stats.max_strain_error.0,
+                "final_strain_error": stats.max_strain_error.1,
+                "kinetic_energy_j": stats.kinetic_energy,
+                "max_motion_kinetic_energy_j": stats.max_motion_energy,
                 "lowest_node_m": lowest,
                 "hem_width_m": hem.map(|h| h.width),
                 "hem_depth_m": hem.map(|h| h.depth),
@@ -222,12 +195,7 @@ impl PySimulation {
             let base = atelier::run::base_of(&scenario);
             let scene = Scene::load(spec, &base)
                 .map_err(|e| Failure::Atelier(format!("{}: {e}", s.name)))?;
-            let baseline = match &scene.settings.solver {
-                ClothSolver::Party => None,
-                ClothSolver::Xpbd(_) => Some(solvers::XPBD),
-                ClothSolver::MassSpring(_) => Some(solvers::MASS_SPRING),
-            };
-            let tolerance = scene.settings.step.shape.tolerance;
+            let stats = StepStats::new(&scene);
             let sim =
                 Simulation::new(scene).map_err(|e| Failure::Atelier(format!("{}: {e}", s.name)))?;
             let cloth_triangles = sim.cloth_triangles().to_vec();
@@ -237,17 +205,7 @@ impl PySimulation {
                 file: scenario.clone(),
                 inner: Mutex::new(Inner {
                     sim,
-                    baseline,
-                    tolerance,
-                    tally: Tally::default(),
-                    steps: 0,
-                    max_strain_error: 0.0,
-                    last_strain_error: 0.0,
-                    kinetic_energy: 0.0,
-                    max_motion_energy: 0.0,
-                    max_penetration: 0.0,
-                    steps_with_penetration: 0,
-                    inside: 0,
+                    stats,
                     failure: None,
                     ended: false,
                 }),
@@ -399,7 +357,7 @@ impl PySimulation {
             Ok((
                 inner.sim.time(),
                 format!("{:?}", inner.sim.phase()),
-                inner.steps,
+                inner.stats.steps,
             ))
         })?;
         Ok(format!(
