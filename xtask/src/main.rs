@@ -38,11 +38,14 @@
 //!   every scenario of `fixtures/scenarios/` (or some), `summary.json` and `summary.md`, and on
 //!   a full run (or one with only `--skip`) `docs/results.md` with its gallery; fails if a
 //!   scenario fails or misses an expectation.
+//! - `cargo xtask long-tests [--list]` — the tests marked `#[ignore = "long: …"]`, kept out of
+//!   `cargo test` for CI's 30-minute budget, found in the sources and run (`long_tests`).
 
 mod bench_report;
 mod figures;
 mod knob_table;
 mod layout;
+mod long_tests;
 mod run_scenarios;
 
 use std::path::{Path, PathBuf};
@@ -106,6 +109,13 @@ enum Command {
     /// Check the layout rules: no import cycle between a crate's modules, no source file over
     /// 800 lines without a `//! Length:` line saying why (also run by `cargo test`).
     CheckLayout,
+    /// Run the tests marked `#[ignore = "long: …"]`, which `cargo test` skips for CI's time
+    /// budget (found in the sources; about an hour on 2 cores).
+    LongTests {
+        /// Only list them, with their files and reasons.
+        #[arg(long)]
+        list: bool,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -200,6 +210,12 @@ fn main() -> Result<()> {
             }
         }
         Command::CheckLayout => layout::main(&repository_root())?,
+        Command::LongTests { list } => {
+            if !long_tests::run(&repository_root(), list)? {
+                eprintln!("a long test failed (see above)");
+                std::process::exit(1);
+            }
+        }
     }
     Ok(())
 }

@@ -142,6 +142,7 @@ fn the_skirt_hem_widens_with_the_fabrics_bending_length() {
 /// The eight-panel dress with bending hysteresis off (elastic bending B only): ordered
 /// (measured 47.0 / 49.9 / 50.5 cm).
 #[test]
+#[ignore = "long: three dresses sewn and settled 3 s each (11.5 minutes on 2 cores, session 19); the skirt's ordering above is in CI"]
 fn the_dress_hem_widens_with_bending_length_without_bending_hysteresis() {
     assert_orders("dress, hysteresis off", all("dress_sewn", false));
 }

@@ -203,6 +203,7 @@ fn a_sheet_pinned_at_two_corners_converges_without_long_range_attachments() {
 
 /// The same on 100 × 100 (1 cm cells); the stretch is reported, not asserted (above).
 #[test]
+#[ignore = "long: 10 000 nodes for 1.5 s, twice (over 3 minutes on 2 cores, session 19); the 50 × 50 sheet above is in CI"]
 fn a_100x100_sheet_pinned_at_two_corners_converges() {
     let (stretch, share) = corner_pinned(100, 1.0, false);
     eprintln!(
