@@ -34,8 +34,10 @@ fi
 step "npm ci (crates/cli/viewer)"
 (cd "$here" && npm ci --no-audit --no-fund --loglevel=error)
 
-step "cargo build --release -p atelier-cli"
-(cd "$root" && cargo build --release -p atelier-cli --quiet)
+# As `cargo test --workspace --release` builds it: a no-op after that command (.ci/run), where
+# `cargo build -p atelier-cli` would rebuild most of the program with other features.
+step "cargo test --workspace --release --no-run"
+(cd "$root" && cargo test --workspace --release --no-run --quiet)
 atelier="$root/target/release/atelier"
 
 out="$root/target/viewer-test"
