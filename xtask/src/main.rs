@@ -110,7 +110,7 @@ enum Command {
     /// 800 lines without a `//! Length:` line saying why (also run by `cargo test`).
     CheckLayout,
     /// Run the tests marked `#[ignore = "long: …"]`, which `cargo test` skips for CI's time
-    /// budget (found in the sources; about an hour on 2 cores).
+    /// budget (found in the sources; about half an hour on 2 cores).
     LongTests {
         /// Only list them, with their files and reasons.
         #[arg(long)]
