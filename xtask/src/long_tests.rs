@@ -145,7 +145,15 @@ pub fn run(root: &Path, list: bool) -> Result<bool> {
     }
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .current_dir(root)
-        .args(["test", "--workspace", "--release", "--lib", "--bins", "--test", "*"])
+        .args([
+            "test",
+            "--workspace",
+            "--release",
+            "--lib",
+            "--bins",
+            "--test",
+            "*",
+        ])
         .args(["--", "--ignored"])
         .args(&names)
         .status()
