@@ -274,7 +274,7 @@ mod tests {
 
     /// The third list, shortened in the same way: run by `cargo xtask long-tests`.
     #[test]
-    #[ignore = "long: five dresses sewn, shortened (about 7 minutes on 2 cores, session 19)"]
+    #[ignore = "long: five dresses sewn, shortened (222 s on 2 cores, session 19)"]
     fn the_scenarios_left_to_the_long_tests_meet_their_running_expectations_shortened() {
         long_scenarios_shortened(|l| l.later, 0, 1);
     }
