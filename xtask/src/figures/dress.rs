@@ -1,7 +1,7 @@
 //! The sewn dress in silk, cotton broad and denim at rest, side by side (issue 21, item 7): front
 //! and side views, with bending hysteresis (the defaults) and without, and a table of the hems'
 //! extents (`metrics::hem_extent`, the report's `hem_width_m` / `hem_depth_m`). The same runs as
-//! `crates/atelier/tests/fabrics_on_body.rs`, which asserts the ordering.
+//! `crates/atelier/tests/own/fabrics_on_body.rs`, which asserts the ordering.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -79,7 +79,7 @@
 //!   (`d₀ < 0` its distance at the start), in front by the end of the step as in PARTY.
 //!   (Measured: pushed out within one substep, a node of the explicit model leaves with the
 //!   push over the substep, `d₀/h`, up to 75 m/s at h = 40 µs, and the mass-spring skirt of
-//!   `crates/atelier/tests/baselines.rs` rang up to 100 m/s within 0.05 s; with the gradual
+//!   `crates/atelier/tests/own/baselines.rs` rang up to 100 m/s within 0.05 s; with the gradual
 //!   push its fastest node stays at the 5–10 m/s its placement's strains release.)
 //!   Pinned nodes are left alone.
 //! - `resolve` is called once, after the last substep (pass 0): it sees the whole step as

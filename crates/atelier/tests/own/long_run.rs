@@ -2,7 +2,7 @@
 //! motion relative to the body, no creeping down the body, no penetration beyond the 6 s
 //! scenario's bound. 1.5–3 minutes on the unconverged step; on the converged step (6 000
 //! steps solved to the tolerance) more than 16 minutes, over CI's budget: ignored, run by hand
-//! with `cargo test --release -p atelier --test long_run -- --ignored` (docs/performance.md).
+//! with `cargo test --release -p atelier --test own long_run:: -- --ignored` (docs/performance.md).
 
 use std::path::PathBuf;
 

@@ -3,15 +3,13 @@
 //! against the body by an independent measure (parry's signed distance to each posed part mesh,
 //! not the contact's union distance).
 
-mod garment_common;
-
 use std::path::PathBuf;
 
+use crate::garment_common::{all_finite, deepest_inside_any_frame};
 use atelier::pipeline::{GarmentRun, run_garment};
 use atelier::report::Report;
 use atelier::run::{RunOptions, run};
 use atelier::scenario::{Scenario, ScenarioKind};
-use garment_common::{all_finite, deepest_inside_any_frame};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")

@@ -4,15 +4,13 @@
 //! pair sewn, no node inside the body in any frame (measured independently, on each posed part's
 //! own mesh), nothing non-finite.
 
-mod garment_common;
-
 use std::path::PathBuf;
 
+use crate::garment_common::{all_finite, deepest_inside_any_frame};
 use atelier::pipeline::run_garment;
 use atelier::scenario::{Scenario, ScenarioKind};
 use atelier::{ClothSolver, GarmentSpec};
 use atelier_solver::baselines::{MassSpringParams, XpbdParams};
-use garment_common::{all_finite, deepest_inside_any_frame};
 
 fn scenarios() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios")

@@ -1,4 +1,4 @@
-//! Helpers shared by the garment integration tests (`dress.rs`, `baselines.rs`).
+//! Helpers shared by the garment tests (`dress.rs`, `baselines.rs`).
 
 use atelier::pipeline::GarmentRun;
 use atelier_collide::V3;
