@@ -1,4 +1,4 @@
-//! The facade's integration tests, in one test binary (one link instead of twelve, and the
+//! The facade's integration tests, in one test binary (one link instead of eleven, and the
 //! harness runs tests of different files side by side; session 20). Each file is a module:
 //!
 //! - [`baselines`]: the baseline solvers (XPBD, mass-spring) in the garment pipeline;
