@@ -361,13 +361,7 @@ impl Settings {
                 ));
             }
         }
-        self.step.validate().map_err(|e| {
-            InvalidValue::new(
-                ErrorKind::OutOfRange,
-                format!("settings.step.{}", e.name),
-                e.to_string(),
-            )
-        })?;
+        check_step(&self.step)?;
         let baseline = match &self.solver {
             ClothSolver::Party => Ok(()),
             ClothSolver::Xpbd(p) => p.validate(),
@@ -449,6 +443,17 @@ pub enum SceneError {
     /// `body` and `body_scan` both given.
     #[error("a garment scene takes `body` or `body_scan`, not both")]
     TwoBodies,
+}
+
+/// `settings.step` checked, an error naming the field as the scenario file spells it.
+pub(crate) fn check_step(step: &StepParams) -> Result<(), InvalidValue> {
+    step.validate().map_err(|e| {
+        InvalidValue::new(
+            ErrorKind::OutOfRange,
+            format!("settings.step.{}", e.name),
+            e.to_string(),
+        )
+    })
 }
 
 impl Garment {

@@ -38,6 +38,14 @@ pub trait Integrator: Send {
         false
     }
 
+    /// Set the shape stage's tolerance (the largest relative strain error a step must meet)
+    /// for the steps from now on. Returns whether the integrator has one; the default (the
+    /// baselines, which have none) ignores it and returns false. The caller checks the value.
+    fn set_shape_tolerance(&mut self, tolerance: f64) -> bool {
+        let _ = tolerance;
+        false
+    }
+
     /// Per-node external forces (N, one per node; empty: none) added to every step from now on.
     /// Returns whether the integrator applies them; the default ignores them and returns false
     /// (the baselines).
@@ -90,6 +98,11 @@ impl Integrator for Party {
     }
 
     fn has_tolerance(&self) -> bool {
+        true
+    }
+
+    fn set_shape_tolerance(&mut self, tolerance: f64) -> bool {
+        self.params.shape.tolerance = tolerance;
         true
     }
 

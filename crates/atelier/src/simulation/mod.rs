@@ -23,6 +23,7 @@ use atelier_body::kinematics::Posed;
 use atelier_body::model::LabelledMesh;
 use atelier_collide::parts::Motion as PartMotion;
 use atelier_collide::{ContactError, ContactMaterial, ContactParams, RigidParts, V3};
+use atelier_fabric::InvalidValue;
 use atelier_solver::baselines::{MassSpring, Xpbd};
 use atelier_solver::integrator::{
     Integrator, MassSpringIntegrator, Party, StepInput, XpbdIntegrator,
@@ -285,6 +286,20 @@ impl Simulation {
             warnings: scene.notes.clone(),
             scene,
         })
+    }
+
+    /// Set the shape stage's tolerance (`settings.step.shape.tolerance`, the largest relative
+    /// strain error a step must meet) for the steps from now on: a loose one while dressing and
+    /// a tight one for a measurement, or one sewn state settled at two tolerances (what
+    /// `docs/validation.md` compares for the sewn dress). A value outside the field's range is
+    /// refused, naming the field, and nothing changes. `Ok(false)`: the scene's solver is a
+    /// baseline, which has no tolerance (the value is kept in the settings, unused).
+    pub fn set_shape_tolerance(&mut self, tolerance: f64) -> Result<bool, InvalidValue> {
+        let mut step = self.scene.settings.step.clone();
+        step.shape.tolerance = tolerance;
+        crate::scene::check_step(&step)?;
+        self.scene.settings.step = step;
+        Ok(self.integrator.set_shape_tolerance(tolerance))
     }
 
     /// The scene.

@@ -10,6 +10,7 @@ use atelier::pipeline::{GarmentRun, run_garment};
 use atelier::report::Report;
 use atelier::run::{RunOptions, run};
 use atelier::scenario::{Scenario, ScenarioKind};
+use atelier::{ClothSolver, Scene, Simulation};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -183,4 +184,102 @@ fn the_dress_is_dressed_through_the_body_by_one_sided_contact() {
         "{:.2} mm inside after the push",
         deepest * 1e3
     );
+}
+
+/// `Simulation::set_shape_tolerance`: a value outside `settings.step.shape.tolerance`'s range
+/// (0, 0.1] is refused naming the field, and nothing changes; a PARTY scene takes the new value
+/// (true), a baseline has no tolerance (false).
+#[test]
+fn a_shape_tolerance_out_of_range_is_refused_and_changes_nothing() {
+    let spec = spec("skirt_sewn", 0.1, 0.0);
+    let mut sim = Simulation::new(Scene::load(&spec, &scenarios()).expect("scene")).expect("sim");
+    let before = sim.scene().settings.step.shape.tolerance;
+    for bad in [0.0, -1e-4, 0.5, f64::NAN, f64::INFINITY] {
+        let e = sim.set_shape_tolerance(bad).expect_err("refused");
+        assert_eq!(e.field, "settings.step.shape.tolerance", "{bad}: {e}");
+        assert_eq!(sim.scene().settings.step.shape.tolerance, before);
+    }
+    assert_eq!(sim.set_shape_tolerance(before / 10.0), Ok(true));
+    assert_eq!(sim.scene().settings.step.shape.tolerance, before / 10.0);
+    let mut xpbd = spec.clone();
+    xpbd.settings.solver = ClothSolver::Xpbd(Default::default());
+    let mut sim = Simulation::new(Scene::load(&xpbd, &scenarios()).expect("scene")).expect("sim");
+    assert_eq!(sim.set_shape_tolerance(1e-5), Ok(false));
+}
+
+/// Issue 21, item 1 on the sewn dress: the same sewn state settled 3 s at the default shape
+/// tolerance and at a ten times tighter one ends within 2 mm RMS. Two runs from the start
+/// cannot tell the tolerance from the path (their pairs are sewn at different steps, and
+/// friction then holds each where it came to rest: 5.4 mm apart, `docs/validation.md`, "Item 1
+/// on the dress at rest"); here both runs take the same steps until every pair is sewn
+/// (asserted bit for bit) and only then does one of them tighten its tolerance. Every step of
+/// both meets its tolerance.
+#[test]
+#[ignore = "long: two dresses settled 3 s each, one at a tenth of the tolerance (about 4 min on 2 cores)"]
+fn the_sewn_dress_settled_at_a_tenth_of_the_tolerance_ends_within_2_mm() {
+    let spec = spec("dress_sewn", 3.0, 0.0);
+    let make = || Simulation::new(Scene::load(&spec, &scenarios()).expect("scene")).expect("sim");
+    let (mut loose, mut tight) = (make(), make());
+    let sew = |s: &mut Simulation| {
+        while s.sewn_at().is_none() {
+            s.step()
+                .expect("steps")
+                .expect("sewn before the schedule ends");
+        }
+    };
+    std::thread::scope(|scope| {
+        scope.spawn(|| sew(&mut loose));
+        sew(&mut tight);
+    });
+    assert_eq!(loose.time(), tight.time());
+    assert!(
+        loose.state().positions == tight.state().positions,
+        "the two runs took different steps before the switch"
+    );
+    let tolerance = loose.scene().settings.step.shape.tolerance;
+    assert_eq!(tight.set_shape_tolerance(tolerance / 10.0), Ok(true));
+    let settle = |s: &mut Simulation| {
+        let (mut steps, mut missed) = (0usize, 0usize);
+        while let Some(o) = s.step().expect("steps") {
+            steps += 1;
+            missed += usize::from(!o.report.converged);
+        }
+        (steps, missed)
+    };
+    let ((loose_steps, loose_missed), (tight_steps, tight_missed)) = std::thread::scope(|scope| {
+        let h = scope.spawn(|| settle(&mut loose));
+        let t = settle(&mut tight);
+        (h.join().expect("settled"), t)
+    });
+    let (a, b) = (&loose.state().positions, &tight.state().positions);
+    let n = a.len() as f64;
+    let rms = (a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).norm_squared())
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    let (largest, at) = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).norm())
+        .enumerate()
+        .fold((0.0f64, 0), |m, (i, d)| if d > m.0 { (d, i) } else { m });
+    let speed = |s: &Simulation| {
+        let v = &s.state().velocities;
+        (v.iter().map(|v| v.norm_squared()).sum::<f64>() / v.len() as f64).sqrt()
+    };
+    println!(
+        "sewn at {:.2} s; tolerance {tolerance:e}: {loose_steps} steps, {loose_missed} above it, RMS speed at the end {:.2} mm/s; {:e}: {tight_steps} steps, {tight_missed} above it, {:.2} mm/s; apart at {:.2} s: RMS {:.3} mm, largest {:.2} mm (node {at})",
+        loose.sewn_at().expect("sewn"),
+        speed(&loose) * 1e3,
+        tolerance / 10.0,
+        speed(&tight) * 1e3,
+        loose.time(),
+        rms * 1e3,
+        largest * 1e3,
+    );
+    assert_eq!((loose_missed, tight_missed), (0, 0));
+    assert!(rms <= 2e-3, "{:.3} mm RMS apart (goal ≤ 2 mm)", rms * 1e3);
 }
