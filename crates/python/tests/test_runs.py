@@ -118,7 +118,7 @@ def test_a_fabric_from_kes_drapes_as_its_file():
         (lambda f: atelier.drape(f, max_tim=1.0), ValueError, "`max_tim`: unknown field"),
         (lambda f: atelier.drape(f, max_time="1"), TypeError, "`max_time`"),
         (lambda f: atelier.drape(f, max_time=-1.0), ValueError, "`max_time`"),
-        (lambda f: atelier.drape(f, n_rings=1), ValueError, "`n_around`"),
+        (lambda f: atelier.drape(f, n_rings=1), ValueError, "`n_rings`"),
         (lambda f: atelier.drape(f, form="Plate"), ValueError, "`form`: unknown variant"),
         (lambda f: atelier.drape(f, step={"damping": -1.0}, max_time=0.01), atelier.AtelierError, "`damping`"),
         (lambda f: atelier.cantilever(f, direction="bias"), ValueError, "`direction`"),

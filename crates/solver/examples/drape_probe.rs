@@ -2,7 +2,7 @@
 //! `cargo run --release -p atelier-solver --example drape_probe -- FABRIC [key=value ...]`
 //! with keys `around`, `rings`, `dt`, `tol`, `cap`, `shear` (scale), `measure` (midpoint or
 //! corners), `b` (bending scale), `g` (scale of G), `hg` (scale of 2HG and 2HG5), `seed`,
-//! `max_time`, `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs). Prints the drape,
+//! `max_time`, `support` (hinged or clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs). Prints the drape,
 //! the convergence counts and the wall time.
 
 use std::time::Instant;
@@ -47,6 +47,9 @@ fn main() {
         });
     }
     let mut scene = DrapeScene::jis(get("around", 72.0) as usize, get("rings", 8.0) as usize);
+    if word("support", "hinged") == "clamped" {
+        scene.support = atelier_solver::scenes::Support::Clamped;
+    }
     scene.perturbation = 1e-4;
     scene.seed = get("seed", 1.0) as u64;
     scene.cloth_options.form = AnisotropyForm::Compliance;

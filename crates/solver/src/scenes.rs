@@ -5,7 +5,9 @@
 //! As in the thesis, the specimen is an annulus whose inner ring is held in space (a
 //! "doughnut with a hole", which spares the collision with the support table); the part of
 //! the specimen lying on the support is not simulated, and the support disk is added to the
-//! shadow when the drape coefficient is measured.
+//! shadow when the drape coefficient is measured. The JIS tester holds the specimen between two
+//! disks, so its scene also holds a second ring inside the rim ([`Support::Clamped`]); the
+//! thesis's hole is hinged ([`Support::Hinged`]).
 //!
 //! - [`DrapeScene::jis`]: JIS L 1096, Ø 25.4 cm on Ø 12.7 cm.
 //! - [`DrapeScene::thesis`]: the thesis's Ø 63.5 cm disk with a Ø 12.7 cm hole on a 60 × 5 cell
@@ -77,27 +79,31 @@ pub struct DrapeScene {
 }
 
 impl DrapeScene {
-    /// JIS L 1096: Ø 25.4 cm specimen on a Ø 12.7 cm support, hinged as in the thesis, default
-    /// cloth options, flat start.
+    /// JIS L 1096: Ø 25.4 cm specimen on a Ø 12.7 cm support, clamped as the tester holds it
+    /// (between its two disks: the cloth leaves the support horizontally), default cloth
+    /// options, flat start. (Until session 21 hinged, as the thesis's hole; measured in
+    /// `docs/validation.md`, "The support's rim".)
     pub fn jis(n_around: usize, n_rings: usize) -> Self {
         Self {
             specimen_diameter: 0.254,
             support_diameter: 0.127,
             n_around,
             n_rings,
-            support: Support::Hinged,
+            support: Support::Clamped,
             cloth_options: ClothOptions::default(),
             perturbation: 0.0,
             seed: 1,
         }
     }
 
-    /// The thesis §3.9.3: Ø 63.5 cm with a Ø 12.7 cm hole, 60 × 5 cells (6 rings of nodes).
+    /// The thesis §3.9.3: Ø 63.5 cm with a Ø 12.7 cm hole, 60 × 5 cells (6 rings of nodes),
+    /// hinged at the hole's rim as the thesis models it.
     pub fn thesis() -> Self {
         Self {
             specimen_diameter: 0.635,
             n_around: 60,
             n_rings: 6,
+            support: Support::Hinged,
             ..Self::jis(60, 6)
         }
     }
@@ -543,7 +549,8 @@ mod tests {
         // (the inscribed polygon), and no nodes.
         let s = DrapeScene::jis(24, 3);
         let (cloth, state) = s.build(&test_fabric()).expect("scene");
-        assert_eq!(cloth.pins().len(), 24);
+        // Clamped: the rim ring and one ring inside it held.
+        assert_eq!(cloth.pins().len(), 48);
         let m = s.measure(&cloth, &state);
         let polygon = 0.5 * 24.0 * 0.127f64.powi(2) * (std::f64::consts::TAU / 24.0).sin();
         assert!((m.shadow_area - polygon).abs() / polygon < 1e-5);

@@ -582,11 +582,27 @@ impl Scenario {
                         format!("{} must be finite and ≥ 0", d.perturbation),
                     );
                 }
-                if d.n_around.is_some_and(|n| n < 3) || d.n_rings.is_some_and(|n| n < 2) {
+                if d.n_around.is_some_and(|n| n < 3) {
                     return bad(
                         "kind.n_around",
                         ErrorKind::OutOfRange,
-                        "need at least 3 nodes around and 2 rings".into(),
+                        "need at least 3 nodes around".into(),
+                    );
+                }
+                // The JIS specimen is clamped: a second held ring one spacing inside the rim,
+                // which must not reach the centre.
+                let rings = match d.tester {
+                    Tester::Jis => 3,
+                    Tester::Thesis => 2,
+                };
+                if let Some(n) = d.n_rings.filter(|&n| n < rings) {
+                    return bad(
+                        "kind.n_rings",
+                        ErrorKind::OutOfRange,
+                        format!(
+                            "{n}: the {:?} tester needs at least {rings} rings",
+                            d.tester
+                        ),
                     );
                 }
                 at_most(

@@ -67,6 +67,26 @@ fn errors_name_position_and_field() {
     assert_eq!(e.field, "name");
 }
 
+/// Too few rings for the tester: the clamped JIS specimen needs a second held ring inside the
+/// rim (3 rings), the thesis's hinged hole 2; the error names `kind.n_rings`.
+#[test]
+fn too_few_rings_for_the_tester_are_refused() {
+    let drape = |tester: &str, rings: usize| {
+        parse(&format!(
+            r#"(name: "d", reproduces: "x", kind: Drape(fabric: "f.ron", tester: {tester}, n_rings: {rings}))"#
+        ))
+    };
+    let e = drape("Jis", 2).expect_err("JIS with 2 rings");
+    assert_eq!(e.field, "kind.n_rings", "{e}");
+    assert_eq!(e.kind, ErrorKind::OutOfRange, "{e}");
+    assert!(drape("Jis", 3).is_ok());
+    assert!(drape("Thesis", 2).is_ok());
+    assert_eq!(
+        drape("Thesis", 1).expect_err("1 ring").field,
+        "kind.n_rings"
+    );
+}
+
 /// An expectation that no run can miss is refused with its field, the metric's physical range
 /// and where the expectation is (issue 23: eight drape scenarios once "expected" a drape
 /// coefficient in [0, 100] or [−1, 101]); a bound inside the range, or a one-sided bound on a

@@ -13,6 +13,8 @@
 //! - a seeded 0.1 mm vertical perturbation of the free nodes (a specimen is never perfectly
 //!   flat); drape is multistable, so every fabric is run from [`SEEDS`] perturbations and the
 //!   median DC and node count are compared, the spread reported;
+//! - the JIS specimen clamped at the support's rim, as the tester's two disks hold it
+//!   (`Support::Clamped`; hinged until session 21: 2.4–8.3 points lower, one node more);
 //! - the fold threshold (5 % of the overhang, σ 5° smoothing) was fixed before the first run;
 //!   the rest criterion is the default (RMS speed below 5 mm/s for 0.2 s), cap 6 s.
 //! - The fixtures' shear values (G, 2HG, 2HG5) are banded guesses, not measurements of the
@@ -172,9 +174,10 @@ fn table(title: &str, base: &DrapeScene, all: &[Runs]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "\n### {title}: Ø {:.1} cm on Ø {:.1} cm, {} × {} cells, Δt {} ms, {} seeds",
+        "\n### {title}: Ø {:.1} cm on Ø {:.1} cm ({:?}), {} × {} cells, Δt {} ms, {} seeds",
         base.specimen_diameter * 100.0,
         base.support_diameter * 100.0,
+        base.support,
         base.n_around,
         base.n_rings - 1,
         StepInput::default().dt * 1e3,
@@ -276,6 +279,22 @@ fn assert_published_ordering(all: &[Runs], what: &str) {
 /// The goal's bounds (DC within 5 points, nodes within ±1) for the fabrics that meet them
 /// (`docs/validation.md` lists the misses with their numbers and diagnosis).
 fn assert_goal(all: &[Runs], which: &[usize], what: &str) {
+    assert_dc_goal(all, which, what);
+    for &k in which {
+        let (f, r) = (&FABRICS[k], &all[k]);
+        assert!(
+            r.median_nodes().abs_diff(f.nodes) <= NODES_GOAL,
+            "{what}: {} median nodes {} against {}",
+            f.label,
+            r.median_nodes(),
+            f.nodes
+        );
+    }
+}
+
+/// The goal's DC half (within 5 points) for the fabrics whose DC meets it, whatever their node
+/// count.
+fn assert_dc_goal(all: &[Runs], which: &[usize], what: &str) {
     for &k in which {
         let (f, r) = (&FABRICS[k], &all[k]);
         assert!(
@@ -284,13 +303,6 @@ fn assert_goal(all: &[Runs], which: &[usize], what: &str) {
             f.label,
             r.median_dc(),
             f.dc
-        );
-        assert!(
-            r.median_nodes().abs_diff(f.nodes) <= NODES_GOAL,
-            "{what}: {} median nodes {} against {}",
-            f.label,
-            r.median_nodes(),
-            f.nodes
         );
     }
 }
@@ -310,6 +322,7 @@ fn drape_jis_at_convergence_orders_the_matsudaira_fabrics() {
     assert_converged(&all, "JIS 72 × 8");
     assert_published_ordering(&all, "JIS 72 × 8");
     assert_goal(&all, &GOAL_MET_JIS, "JIS 72 × 8");
+    assert_dc_goal(&all, &DC_MET_JIS, "JIS 72 × 8");
 }
 
 #[test]
@@ -338,6 +351,11 @@ fn drape_thesis_protocol_dt_10ms_2s() {
 
 /// The fabrics (indices into [`FABRICS`]) that meet the goal on the JIS drape at convergence.
 const GOAL_MET_JIS: [usize; 0] = [];
+
+/// The fabrics whose median DC on the JIS drape at convergence is within 5 points of
+/// Matsudaira's (since the clamped rim, session 21): cotton broad, polyester tropical, polyester
+/// faille. Wool tropical misses (−11.6 points), and every node count misses (+3 to +5).
+const DC_MET_JIS: [usize; 3] = [0, 2, 3];
 
 /// The fabrics whose thesis-disc node count is within ±1 of the thesis's.
 const THESIS_MET: [usize; 0] = [];
