@@ -2,7 +2,7 @@
 //! `cargo run --release -p atelier-solver --example drape_probe -- FABRIC [key=value ...]`
 //! with keys `around`, `rings`, `dt`, `tol`, `cap`, `shear` (scale), `measure` (midpoint or
 //! corners), `b` (bending scale), `g` (scale of G), `hg` (scale of 2HG and 2HG5), `seed`,
-//! `max_time`, `support` (hinged or clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs). Prints the drape,
+//! `max_time`, `perturb` (m), `ramp` (s of gravity ramped up from zero first), `support` (hinged or clamped; default the JIS scene's, clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs). Prints the drape,
 //! the convergence counts and the wall time.
 
 use std::time::Instant;
@@ -47,10 +47,12 @@ fn main() {
         });
     }
     let mut scene = DrapeScene::jis(get("around", 72.0) as usize, get("rings", 8.0) as usize);
-    if word("support", "hinged") == "clamped" {
-        scene.support = atelier_solver::scenes::Support::Clamped;
+    match word("support", "").as_str() {
+        "hinged" => scene.support = atelier_solver::scenes::Support::Hinged,
+        "clamped" => scene.support = atelier_solver::scenes::Support::Clamped,
+        _ => {}
     }
-    scene.perturbation = 1e-4;
+    scene.perturbation = get("perturb", 1e-4);
     scene.seed = get("seed", 1.0) as u64;
     scene.cloth_options.form = AnisotropyForm::Compliance;
     let method = match word("method", "direct").as_str() {
@@ -131,6 +133,15 @@ fn main() {
         return;
     }
     let t0 = Instant::now();
+    // Gravity ramped up from zero over `ramp` seconds (a quasi-static release) before the run.
+    let ramp = get("ramp", 0.0);
+    while state.time < ramp - 1e-9 {
+        let s = ((state.time + input.dt) / ramp).min(1.0);
+        let g = input.gravity.map(|c| c * s);
+        solver
+            .step(&cloth, &mut state, &params, StepInput { gravity: g, ..input })
+            .expect("ramp step");
+    }
     let run = run_drape(
         &scene,
         &cloth,
