@@ -74,7 +74,7 @@ pub(super) fn peers_table(
         let steps = r["steps"].as_f64().unwrap_or(f64::NAN);
         let _ = writeln!(
             t,
-            "| atelier PARTY | `drape_jis_cotton_broad`: {} nodes, Δt 1 ms, {:.1} s: the annulus outside the support, its rim ring pinned (hinged; the thesis's \"doughnut\") | {:.2} | {:.1} % | published for this fabric: 82.9 % (Matsudaira et al. 2015) |",
+            "| atelier PARTY | `drape_jis_cotton_broad`: {} nodes, Δt 1 ms, {:.1} s: the annulus outside the support, its rim ring and one ring inside it pinned (clamped, as the tester holds it; hinged until session 21) | {:.2} | {:.1} % | published for this fabric: 82.9 % (Matsudaira et al. 2015) |",
             r["nodes"].as_u64().unwrap_or(0),
             r["simulated_s"].as_f64().unwrap_or(f64::NAN),
             r["stage_s"]["total"].as_f64().unwrap_or(f64::NAN) / steps * 1e3,
