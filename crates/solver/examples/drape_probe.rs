@@ -139,7 +139,15 @@ fn main() {
         let s = ((state.time + input.dt) / ramp).min(1.0);
         let g = input.gravity.map(|c| c * s);
         solver
-            .step(&cloth, &mut state, &params, StepInput { gravity: g, ..input })
+            .step(
+                &cloth,
+                &mut state,
+                &params,
+                StepInput {
+                    gravity: g,
+                    ..input
+                },
+            )
             .expect("ramp step");
     }
     let run = run_drape(
