@@ -2,8 +2,9 @@
 //! `cargo run --release -p atelier-solver --example drape_probe -- FABRIC [key=value ...]`
 //! with keys `around`, `rings`, `dt`, `tol`, `cap`, `shear` (scale), `measure` (midpoint or
 //! corners), `b` (bending scale), `g` (scale of G), `hg` (scale of 2HG and 2HG5), `seed`,
-//! `max_time`, `perturb` (m), `ramp` (s of gravity ramped up from zero first), `support` (hinged or clamped; default the JIS scene's, clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs). Prints the drape,
-//! the convergence counts and the wall time.
+//! `max_time`, `perturb` (m), `ramp` (s of gravity ramped up from zero first), `support` (hinged
+//! or clamped; default the JIS scene's, clamped), `hysteresis` (0/1), `method` (direct, cg,
+//! jacobi, chebyshev, gs). Prints the drape, the convergence counts and the wall time.
 
 use std::time::Instant;
 
