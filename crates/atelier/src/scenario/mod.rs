@@ -18,14 +18,16 @@
 use std::path::{Path, PathBuf};
 
 use atelier_fabric::{AnisotropyForm, ErrorKind, FileError, InvalidValue};
-use atelier_solver::StepParams;
 use serde::{Deserialize, Serialize};
 
 use crate::scene::GarmentSpec;
 
 pub mod bounds;
+mod drape;
 pub mod string_fit;
 pub mod wet;
+
+pub use drape::{DrapeSpec, Tester};
 
 /// One scenario file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -231,57 +233,6 @@ impl Expectation {
             !v.is_nan() && self.min.is_none_or(|m| v >= m) && self.max.is_none_or(|m| v <= m)
         })
     }
-}
-
-/// The drape tester's geometry.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Tester {
-    /// JIS L 1096: Ø 25.4 cm specimen on a Ø 12.7 cm support; default grid 72 × 8 nodes, Δt 1 ms.
-    Jis,
-    /// The thesis §3.9.3: Ø 63.5 cm with a Ø 12.7 cm hole; default grid 60 × 6 nodes, Δt 2.5 ms.
-    Thesis,
-}
-
-/// A drape test.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DrapeSpec {
-    /// Fabric file (RON).
-    pub fabric: PathBuf,
-    /// Tester geometry.
-    pub tester: Tester,
-    /// Nodes around each ring (default: 72 JIS, 60 thesis).
-    #[serde(default)]
-    pub n_around: Option<usize>,
-    /// Rings of nodes from the support's rim to the edge (default: 8 JIS, 6 thesis).
-    #[serde(default)]
-    pub n_rings: Option<usize>,
-    /// Time step, s (default: 0.001 JIS, 0.0025 thesis: the largest at which the rim ring does
-    /// not chatter, `docs/validation.md`).
-    #[serde(default)]
-    pub dt: Option<f64>,
-    /// Longest simulated time, s. Default 5.
-    #[serde(default = "default_drape_time")]
-    pub max_time: f64,
-    /// Stop once at rest (RMS speed of the free nodes below 5 mm/s for 0.2 s, after 0.5 s), as
-    /// `run_drape`'s default rest criterion; false: run `max_time`. Default true.
-    #[serde(default = "yes")]
-    pub until_rest: bool,
-    /// Seeded vertical perturbation of the free nodes at the start, m. Default 1e-4.
-    #[serde(default = "default_perturbation")]
-    pub perturbation: f64,
-    /// Seed of the perturbation. Default 1.
-    #[serde(default = "default_seed")]
-    pub seed: u64,
-    /// Anisotropy form. Default `Compliance` (the drape tests' choice, `docs/validation.md`).
-    #[serde(default = "default_drape_form")]
-    pub form: AnisotropyForm,
-    /// Interval between recorded frames, s. Default 0.04.
-    #[serde(default = "default_frame_interval")]
-    pub frame_interval: f64,
-    /// Overrides of the solver's step parameters (Δt is set by `dt`; gravity −z).
-    #[serde(default)]
-    pub step: StepParams,
 }
 
 /// The grain direction along a strip: `Warp` (default) or `Weft`.
@@ -589,12 +540,7 @@ impl Scenario {
                         "need at least 3 nodes around".into(),
                     );
                 }
-                // The JIS specimen is clamped: a second held ring one spacing inside the rim,
-                // which must not reach the centre.
-                let rings = match d.tester {
-                    Tester::Jis => 3,
-                    Tester::Thesis => 2,
-                };
+                let rings = d.tester.min_rings();
                 if let Some(n) = d.n_rings.filter(|&n| n < rings) {
                     return bad(
                         "kind.n_rings",
