@@ -2,7 +2,7 @@
 //! `cargo run --release -p atelier-solver --example drape_probe -- FABRIC [key=value ...]`
 //! with keys `around`, `rings`, `dt`, `tol`, `cap`, `shear` (scale), `measure` (midpoint or
 //! corners), `b` (bending scale), `g` (scale of G), `hg` (scale of 2HG and 2HG5), `seed`,
-//! `max_time`, `perturb` (m), `ramp` (s of gravity ramped up from zero first), `support` (hinged
+//! `bratio` (warp B over weft B, their geometric mean kept), `max_time`, `perturb` (m), `ramp` (s of gravity ramped up from zero first), `support` (hinged
 //! or clamped; default the JIS scene's, clamped), `hysteresis` (0/1), `method` (direct, cg,
 //! jacobi, chebyshev, gs). Prints the drape, the convergence counts and the wall time.
 
@@ -46,6 +46,26 @@ fn main() {
         fabric.bending = fabric.bending.map(|s| {
             atelier_fabric::Spindle::new(s.rigidity() * b, s.residual_moment() * b).expect("B")
         });
+    }
+    // Bending anisotropy: warp B and M₀ × √r, weft ÷ √r (their geometric mean kept), the bias
+    // directions again by Huber's rule (docs/fabric.md §6), as a loaded file would derive them.
+    let r = get("bratio", 1.0);
+    if r != 1.0 {
+        let k = r.sqrt();
+        let (w, f) = (&fabric.bending.warp, &fabric.bending.weft);
+        let huber = |a: f64, b: f64| (2.0 / (a.powf(-0.5) + b.powf(-0.5))).powi(2);
+        let warp = atelier_fabric::Spindle::new(w.rigidity() * k, w.residual_moment() * k);
+        let weft = atelier_fabric::Spindle::new(f.rigidity() / k, f.residual_moment() / k);
+        let (warp, weft) = (warp.expect("B"), weft.expect("B"));
+        let bias = atelier_fabric::Spindle::new(
+            huber(warp.rigidity(), weft.rigidity()),
+            huber(warp.residual_moment(), weft.residual_moment()),
+        )
+        .expect("B");
+        fabric.bending.warp = warp;
+        fabric.bending.weft = weft;
+        fabric.bending.bias45 = bias.clone();
+        fabric.bending.bias135 = bias;
     }
     let mut scene = DrapeScene::jis(get("around", 72.0) as usize, get("rings", 8.0) as usize);
     match word("support", "").as_str() {
