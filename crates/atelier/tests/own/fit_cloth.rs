@@ -512,20 +512,26 @@ fn atelier_fit_writes_the_fitted_hysteresis_of_a_turned_strip() {
 
 /// Why there is no tensile-scale fit from drape silhouettes (docs/fit.md): the JIS drape of wool
 /// tropical with both tensile curves 4 × softer and 4 × stiffer (EMT × 4 and ÷ 4) keeps its
-/// drape coefficient within 1.5 points and its node count of the unchanged fabric's — the
-/// silhouette does not carry the tensile scale (measured with the old, unconverged step: DC
-/// 49.04 / 49.59 / 49.65 %, 9 nodes each, for ×0.25 / ×1 / ×4; with the converged step of issue
-/// 21: 34.27 / 35.69 / 36.61 %, 10 nodes each; the fabric hardly stretches under its own weight
-/// there, and the drape's DC moves by a point or two under far smaller perturbations).
+/// median drape coefficient over five seeds of the start's perturbation within 1.5 points of the
+/// unchanged fabric's, and its median node count — the silhouette does not carry the tensile
+/// scale. Medians, since the drape is multistable: one seed compared with one seed measured the
+/// state a run fell into, not the fabric (session 21, clamped rim: EMT × 4 against the unchanged
+/// fabric +3.8 points with seed 1, −3.2 with seed 2; docs/validation.md, "The support's rim").
+/// At Δt 10 ms, as the solver's
+/// drape test at convergence (at the scenario's default 1 ms the fifteen drapes took over 40
+/// minutes). Single-seed history (Δt 1 ms): with the old, unconverged step DC 49.04 / 49.59 /
+/// 49.65 %, 9 nodes each, for ×0.25 / ×1 / ×4; with the converged step of issue 21 and the
+/// hinged rim 34.27 / 35.69 / 36.61 %, 10 nodes each. Fifteen drapes, about 70 s on two cores.
 #[test]
-#[ignore = "long: three JIS drapes of wool tropical to rest (5.7 minutes on 2 cores, session 19)"]
+#[ignore = "missed (session 22): EMT × 4 puts the median DC of five seeds 1.79 points above the unchanged fabric's (bound 1.5), its seeds bimodal (36.1–36.4 / 40.0–40.1 %); docs/validation.md, \"The tensile scale and the drape, by seeds\""]
 fn a_drape_silhouette_does_not_carry_the_tensile_scale() {
+    const SEEDS: [u64; 5] = [1, 2, 3, 4, 5];
     let dir = std::env::temp_dir().join(format!("atelier-tensile-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("dir");
     let text =
         std::fs::read_to_string(root().join("fixtures/fabrics/wool_tropical.ron")).expect("fabric");
-    let drape = |k: f64| {
+    let drape = |k: f64, seed: u64| {
         let scaled = text
             .replace("emt_percent: 5.0", &format!("emt_percent: {}", 5.0 / k))
             .replace("emt_percent: 7.0", &format!("emt_percent: {}", 7.0 / k));
@@ -534,7 +540,7 @@ fn a_drape_silhouette_does_not_carry_the_tensile_scale() {
         std::fs::write(dir.join(format!("{name}.ron")), scaled).expect("write");
         let scenario = Scenario::parse(
             &format!(
-                r#"(name: "{name}", reproduces: "tensile probe (test)", kind: Drape(fabric: "{name}.ron", tester: Jis, max_time: 5.0))"#
+                r#"(name: "{name}", reproduces: "tensile probe (test)", kind: Drape(fabric: "{name}.ron", tester: Jis, dt: Some(0.01), max_time: 5.0, seed: {seed}))"#
             ),
             &dir.join("s.ron"),
         )
@@ -546,15 +552,27 @@ fn a_drape_silhouette_does_not_carry_the_tensile_scale() {
             sim.metrics["node_count"].expect("nodes"),
         )
     };
-    let (dc, nodes) = drape(1.0);
+    let medians = |k: f64| {
+        let runs: Vec<(f64, f64)> = SEEDS.iter().map(|&s| drape(k, s)).collect();
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        eprintln!("tensile ×{k}: DC, nodes per seed {runs:.2?}");
+        (
+            median(runs.iter().map(|r| r.0).collect()),
+            median(runs.iter().map(|r| r.1).collect()),
+        )
+    };
+    let (dc, nodes) = medians(1.0);
     for k in [0.25, 4.0] {
-        let (dc_k, nodes_k) = drape(k);
+        let (dc_k, nodes_k) = medians(k);
         eprintln!(
-            "tensile ×{k}: DC {dc_k:.2} % ({nodes_k} nodes) against {dc:.2} % ({nodes} nodes)"
+            "tensile ×{k}: median DC {dc_k:.2} % ({nodes_k} nodes) against {dc:.2} % ({nodes} nodes)"
         );
         assert!(
             (dc_k - dc).abs() < 1.5 && (nodes_k - nodes).abs() < 0.5,
-            "×{k}: {dc_k} against {dc}"
+            "×{k}: median DC {dc_k} ({nodes_k} nodes) against {dc} ({nodes})"
         );
     }
     std::fs::remove_dir_all(&dir).ok();
