@@ -2,7 +2,7 @@
 //! OBJ, PLY and GLB and read back byte by byte; invalid input and unwritable targets fail with
 //! typed errors and leave nothing behind.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use atelier::export::{
     Animation, ExportError, FrameSelection, FrameValues, GlbOptions, Interpolation, MeshPart,
@@ -10,12 +10,11 @@ use atelier::export::{
 };
 use serde_json::Value;
 
-/// A fresh, empty directory for one test.
-fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("atelier-export-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
+use crate::scratch::Scratch;
+
+/// A fresh, empty directory for one test, removed when it is done.
+fn scratch(test: &str) -> Scratch {
+    Scratch::new("export", test)
 }
 
 /// Names of the files in `dir`.

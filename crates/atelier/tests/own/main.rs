@@ -17,6 +17,7 @@
 //! fit_cloth::`.
 
 mod garment_common;
+mod scratch;
 
 mod baselines;
 mod degenerate;

@@ -8,6 +8,8 @@ use atelier::report::Report;
 use atelier::run::{RunOptions, outputs, run};
 use atelier::scenario::Scenario;
 
+use crate::scratch::Scratch;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../..")
@@ -15,11 +17,9 @@ fn root() -> PathBuf {
         .expect("repository root")
 }
 
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("atelier-run-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+/// A fresh run folder, removed when the test is done with it.
+fn temp_dir(tag: &str) -> Scratch {
+    Scratch::new("run", tag)
 }
 
 /// The skirt placed around the mannequin and sewn for `sew_limit` s (gravity never starts).
