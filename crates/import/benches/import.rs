@@ -1,5 +1,7 @@
 //! Benchmarks of the import (docs/patterns-import.md): the dress written by ezdxf read from
-//! DXF (R2000 and R12: parse, pieces checked, notches and darts found), one piece planned and
+//! DXF (R2000 and R12: parse, pieces checked, notches and darts found), FreeSewing's Penelope
+//! and Bella read from their SVG (parse, Béziers flattened, halves unfolded, V darts closed),
+//! one piece planned and
 //! gridded with the drafter's corners (the gridding of an imported piece), and the
 //! corner search on the front bodice (every four of its six sharpest vertices planned and
 //! gridded) against gridding it once.
@@ -8,7 +10,7 @@ use std::hint::black_box;
 use std::path::PathBuf;
 
 use atelier_grid::ImproveParams;
-use atelier_import::{PanelOptions, dxf, plan_and_grid};
+use atelier_import::{PanelOptions, dxf, plan_and_grid, svg};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn dir() -> PathBuf {
@@ -23,6 +25,13 @@ fn import(c: &mut Criterion) {
         assert_eq!(dxf::read(&path).expect("reads").pieces.len(), 7);
         group.bench_function(file, |b| {
             b.iter(|| dxf::read(black_box(&path)).expect("reads"))
+        });
+    }
+    for (file, pieces) in [("penelope.svg", 3), ("bella.svg", 3)] {
+        let path = dir().join("../freesewing").join(file);
+        assert_eq!(svg::read(&path).expect("reads").pieces.len(), pieces);
+        group.bench_function(file, |b| {
+            b.iter(|| svg::read(black_box(&path)).expect("reads"))
         });
     }
     group.finish();
