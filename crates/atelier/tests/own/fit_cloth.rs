@@ -517,9 +517,8 @@ fn atelier_fit_writes_the_fitted_hysteresis_of_a_turned_strip() {
 /// scale. Medians, since the drape is multistable: one seed compared with one seed measured the
 /// state a run fell into, not the fabric (session 21, clamped rim: EMT × 4 against the unchanged
 /// fabric +3.8 points with seed 1, −3.2 with seed 2; docs/validation.md, "The support's rim").
-/// At Δt 10 ms, as the solver's
-/// drape test at convergence (at the scenario's default 1 ms the fifteen drapes took over 40
-/// minutes). Single-seed history (Δt 1 ms): with the old, unconverged step DC 49.04 / 49.59 /
+/// At Δt 10 ms, as the solver's drape test at convergence (at the scenario's default 1 ms the
+/// fifteen drapes had not finished after 25 minutes). Single-seed history (Δt 1 ms): with the old, unconverged step DC 49.04 / 49.59 /
 /// 49.65 %, 9 nodes each, for ×0.25 / ×1 / ×4; with the converged step of issue 21 and the
 /// hinged rim 34.27 / 35.69 / 36.61 %, 10 nodes each. Fifteen drapes, about 70 s on two cores.
 #[test]
