@@ -2,9 +2,10 @@
 //! `cargo run --release -p atelier-solver --example drape_probe -- FABRIC [key=value ...]`
 //! with keys `around`, `rings`, `dt`, `tol`, `cap`, `shear` (scale), `measure` (midpoint or
 //! corners), `b` (bending scale), `g` (scale of G), `hg` (scale of 2HG and 2HG5), `seed`,
-//! `bratio` (warp B over weft B, their geometric mean kept), `max_time`, `perturb` (m), `ramp` (s of gravity ramped up from zero first), `support` (hinged
-//! or clamped; default the JIS scene's, clamped), `hysteresis` (0/1), `method` (direct, cg,
-//! jacobi, chebyshev, gs). Prints the drape, the convergence counts and the wall time.
+//! `bratio` (warp B over weft B, their geometric mean kept), `max_time`, `perturb` (m), `ramp`
+//! (s of gravity ramped up from zero first), `support` (hinged or clamped; default the JIS
+//! scene's, clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs). Prints
+//! the drape, the convergence counts and the wall time.
 
 use std::time::Instant;
 
@@ -53,7 +54,7 @@ fn main() {
     if r != 1.0 {
         let k = r.sqrt();
         let (w, f) = (&fabric.bending.warp, &fabric.bending.weft);
-        let huber = |a: f64, b: f64| (2.0 / (a.powf(-0.5) + b.powf(-0.5))).powi(2);
+        let huber = atelier_fabric::anisotropy::huber_bias;
         let warp = atelier_fabric::Spindle::new(w.rigidity() * k, w.residual_moment() * k);
         let weft = atelier_fabric::Spindle::new(f.rigidity() / k, f.residual_moment() / k);
         let (warp, weft) = (warp.expect("B"), weft.expect("B"));
