@@ -4,8 +4,11 @@
 //! corners), `b` (bending scale), `g` (scale of G), `hg` (scale of 2HG and 2HG5), `seed`,
 //! `bratio` (warp B over weft B, their geometric mean kept), `max_time`, `perturb` (m), `ramp`
 //! (s of gravity ramped up from zero first), `support` (hinged or clamped; default the JIS
-//! scene's, clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs). Prints
-//! the drape, the convergence counts and the wall time.
+//! scene's, clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs), `m0`
+//! (scale of the bending residual moment M₀ alone), `bband` (bending dead band, × M₀/B),
+//! `stick_slope` (bending), `sband` (shear dead band, rad), `drift` (s stepped after the run,
+//! then where the remaining motion is: one step's move against two steps'). Prints the drape,
+//! the convergence counts and the wall time.
 
 use std::time::Instant;
 
@@ -41,6 +44,12 @@ fn main() {
         if let Some(h5) = s.hysteresis_5deg.as_mut() {
             *h5 *= get("hg", 1.0);
         }
+    }
+    let m0 = get("m0", 1.0);
+    if m0 != 1.0 {
+        fabric.bending = fabric.bending.map(|s| {
+            atelier_fabric::Spindle::new(s.rigidity(), s.residual_moment() * m0).expect("2HB")
+        });
     }
     let b = get("b", 1.0);
     if b != 1.0 {
@@ -99,6 +108,7 @@ fn main() {
         },
         shear: atelier_solver::ShearParams {
             scale: get("shear", 1.0),
+            deadband: get("sband", 1e-4),
             measure: if word("measure", "midpoint") == "corners" {
                 ShearMeasure::Corners
             } else {
@@ -107,6 +117,8 @@ fn main() {
             ..atelier_solver::ShearParams::default()
         },
         bending: atelier_solver::BendingParams {
+            deadband: get("bband", 0.05),
+            stick_slope: get("stick_slope", 4.0),
             off: get("bending_off", 0.0) != 0.0,
             implicit_stick_slope: get("stick", 0.0) != 0.0,
             ..atelier_solver::BendingParams::default()
@@ -231,5 +243,102 @@ fn main() {
             }
         }
         Err(e) => println!("{name}: failed: {e}"),
+    }
+    // `drift=s`: after the run, s seconds more, and where the remaining motion is: each node's
+    // velocity in cylindrical components about the support's axis (RMS radial, tangential,
+    // vertical; the mean angular velocity), the RMS speed per ring, and the displacement over
+    // the interval against the speed times the interval (a steady drift moves by about that,
+    // an oscillation by much less).
+    let drift = get("drift", 0.0);
+    if drift > 0.0 {
+        let start = state.positions.clone();
+        let steps = (drift / input.dt).round() as usize;
+        let mut before = [state.positions.clone(), state.positions.clone()];
+        let mut rms_step = Vec::new();
+        for k in 0..steps {
+            before = [before[1].clone(), state.positions.clone()];
+            let report = solver
+                .step(&cloth, &mut state, &params, input)
+                .expect("drift step");
+            let moved = |from: &[nalgebra::Vector3<f64>]| {
+                let s: f64 = state
+                    .positions
+                    .iter()
+                    .zip(from)
+                    .map(|(x, y)| (x - y).norm_squared())
+                    .sum();
+                (s / from.len() as f64).sqrt()
+            };
+            if k + 4 >= steps {
+                rms_step.push(format!(
+                    "t {:.2}: RMS |Δx| over one step {:.2e} m, over two {:.2e} m, RMS v·Δt {:.2e} m, shape its {}, bending its {}",
+                    state.time,
+                    moved(&before[1]),
+                    moved(&before[0]),
+                    input.dt
+                        * (state.velocities.iter().map(|v| v.norm_squared()).sum::<f64>()
+                            / state.velocities.len() as f64)
+                            .sqrt(),
+                    report.shape_iterations,
+                    report.bending_iterations
+                ));
+            }
+        }
+        for line in &rms_step {
+            println!("  {line}");
+        }
+        let axis = nalgebra::Vector3::new(0.0, 0.0, 1.0);
+        let (mut vr, mut vt, mut vz, mut w, mut n) = (0.0, 0.0, 0.0, 0.0, 0usize);
+        let (mut dsum, mut dtheta) = (0.0, 0.0);
+        let rings = scene.n_rings;
+        let mut per_ring = vec![(0.0, 0usize); rings + 1];
+        for (i, (x, v)) in state.positions.iter().zip(&state.velocities).enumerate() {
+            let radial = nalgebra::Vector3::new(x.x, x.y, 0.0);
+            let r = radial.norm();
+            if r < 1e-6 || v.norm() == 0.0 {
+                continue;
+            }
+            let er = radial / r;
+            let et = axis.cross(&er);
+            vr += v.dot(&er).powi(2);
+            vt += v.dot(&et).powi(2);
+            vz += v.z.powi(2);
+            w += v.dot(&et) / r;
+            n += 1;
+            let d = x - start[i];
+            dsum += d.norm_squared();
+            let a0 = start[i].y.atan2(start[i].x);
+            let a1 = x.y.atan2(x.x);
+            let mut da = a1 - a0;
+            if da > std::f64::consts::PI {
+                da -= 2.0 * std::f64::consts::PI;
+            } else if da < -std::f64::consts::PI {
+                da += 2.0 * std::f64::consts::PI;
+            }
+            dtheta += da;
+            let k = (i / scene.n_around).min(rings);
+            per_ring[k].0 += v.norm_squared();
+            per_ring[k].1 += 1;
+        }
+        let nf = n.max(1) as f64;
+        let rms = ((vr + vt + vz) / nf).sqrt();
+        println!(
+            "drift {drift} s: moving nodes {n}; RMS speed {:.2e} m/s (radial {:.2e}, tangential {:.2e}, vertical {:.2e}); mean angular velocity {:.2e} rad/s; mean turn over the interval {:.2e} rad; RMS displacement {:.2e} m against RMS speed × interval {:.2e} m",
+            rms,
+            (vr / nf).sqrt(),
+            (vt / nf).sqrt(),
+            (vz / nf).sqrt(),
+            w / nf,
+            dtheta / nf,
+            (dsum / nf).sqrt(),
+            rms * drift
+        );
+        let rows: Vec<String> = per_ring
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, c))| *c > 0)
+            .map(|(k, (s, c))| format!("{k}:{:.1e}", (s / *c as f64).sqrt()))
+            .collect();
+        println!("  RMS speed by ring (m/s): {}", rows.join(" "));
     }
 }
