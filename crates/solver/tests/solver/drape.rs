@@ -361,3 +361,52 @@ const DC_MET_JIS: [usize; 3] = [0, 2, 3];
 
 /// The fabrics whose thesis-disc node count is within ±1 of the thesis's.
 const THESIS_MET: [usize; 0] = [];
+
+/// RMS over the nodes of |a − b|, m.
+fn rms_distance(a: &[nalgebra::Vector3<f64>], b: &[nalgebra::Vector3<f64>]) -> f64 {
+    let s: f64 = a.iter().zip(b).map(|(x, y)| (x - y).norm_squared()).sum();
+    (s / a.len().max(1) as f64).sqrt()
+}
+
+#[test]
+#[ignore = "missed (session 23): on 72 × 16 the drape ends in a period-2 oscillation of the hysteretic bending rows (63 µm a step, back within 0.4 µm every two steps); docs/validation.md, \"A period-2 oscillation on refined grids\""]
+fn a_refined_drape_at_rest_does_not_flip_between_two_shapes() {
+    // Polyester tropical on the JIS support, 72 around × 16 rings, Δt 10 ms, the default step,
+    // 3 s: the shape has stopped changing (DC 58.8 % from 1.1 s on, drape_probe). A cloth at
+    // rest moves by (almost) nothing in a step; one still creeping moves about twice as far in
+    // two steps as in one. A step-to-step flip between two shapes moves far in one step and
+    // back in two. Goal: over each of the last four steps, either less than 1 µm RMS, or at
+    // least as far over two steps as over one.
+    let fabric = common::fabric("polyester_tropical");
+    let scene = scene(DrapeScene::jis(72, 16), 1);
+    let (cloth, mut state) = scene.build(&fabric).expect("drape scene");
+    let mut solver = Solver::new();
+    let params = StepParams::default();
+    let input = StepInput::default();
+    let mut history = vec![state.positions.clone(), state.positions.clone()];
+    for step in 0..304 {
+        let report = solver
+            .step(&cloth, &mut state, &params, input)
+            .expect("drape step");
+        assert!(report.converged, "step {step} did not converge");
+        history.push(state.positions.clone());
+        if history.len() > 3 {
+            history.remove(0);
+        }
+        if step < 300 {
+            continue;
+        }
+        let n = history.len();
+        let one = rms_distance(&history[n - 1], &history[n - 2]);
+        let two = rms_distance(&history[n - 1], &history[n - 3]);
+        eprintln!(
+            "t {:.2} s: RMS move over one step {one:.2e} m, over two {two:.2e} m",
+            state.time
+        );
+        assert!(
+            one < 1e-6 || two >= one,
+            "t {:.2} s: the cloth moves {one:.2e} m in a step and {two:.2e} m in two (a flip between two shapes)",
+            state.time
+        );
+    }
+}
