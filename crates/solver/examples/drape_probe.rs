@@ -6,7 +6,7 @@
 //! (s of gravity ramped up from zero first), `support` (hinged or clamped; default the JIS
 //! scene's, clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs), `m0`
 //! (scale of the bending residual moment M₀ alone), `bband` (bending dead band, × M₀/B),
-//! `stick_slope` (bending), `sband` (shear dead band, rad), `drift` (s stepped after the run,
+//! `stick_slope` (bending), `steepest` (0/1: `bending.steepest_slope`), `sband` (shear dead band, rad), `drift` (s stepped after the run,
 //! then where the remaining motion is: one step's move against two steps'). Prints the drape,
 //! the convergence counts and the wall time.
 
@@ -121,6 +121,7 @@ fn main() {
             stick_slope: get("stick_slope", 4.0),
             off: get("bending_off", 0.0) != 0.0,
             implicit_stick_slope: get("stick", 0.0) != 0.0,
+            steepest_slope: get("steepest", 0.0) != 0.0,
             ..atelier_solver::BendingParams::default()
         },
         ..StepParams::default()
@@ -340,5 +341,10 @@ fn main() {
             .map(|(k, (s, c))| format!("{k}:{:.1e}", (s / *c as f64).sqrt()))
             .collect();
         println!("  RMS speed by ring (m/s): {}", rows.join(" "));
+        let m = scene.measure(&cloth, &state);
+        println!(
+            "  after the drift: DC {:.1} % nodes {}",
+            m.drape_coefficient, m.nodes
+        );
     }
 }

@@ -295,6 +295,14 @@ pub struct BendingParams {
     /// `bending.stick_slope`·B, where the fabric has bending hysteresis (instead of B). Default
     /// false (`docs/solver.md`).
     pub implicit_stick_slope: bool,
+    /// [`BendingModel::Implicit`] only: linearise each hysteretic bending row with the
+    /// regularised spindle's steepest slope, `bending.stick_slope`·B, instead of its local slope
+    /// at the start of the step. A row linearised softer than the reversal chord it then
+    /// travels overshoots; on refined grids the cloth flips between two shapes every step and
+    /// never rests (`docs/validation.md`, "A period-2 oscillation on refined grids"). Changes
+    /// no equilibrium of a step that ends where it starts. Default false (opt-in until the
+    /// validation is measured with it).
+    pub steepest_slope: bool,
     /// Regularisation of the bending hysteresis: the tangent of the spindle's square-root curves
     /// is capped at this multiple of B over a tiny band (`Spindle::with_stick_slope`). Range > 1
     /// (∞ = exact); default 4.
@@ -314,6 +322,7 @@ impl Default for BendingParams {
             tolerance: 1e-6,
             max_iterations: 200,
             implicit_stick_slope: false,
+            steepest_slope: false,
             stick_slope: 4.0,
             deadband: 0.05,
             off: false,

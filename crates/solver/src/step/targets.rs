@@ -124,6 +124,7 @@ impl Solver {
         );
         let hysteresis = params.hysteresis && cloth.bending_hysteretic();
         let (stick, band) = (params.bending.stick_slope, params.bending.deadband);
+        let steepest = params.bending.steepest_slope;
         let (pos, states, normal) = (&state.positions, &state.bending, &self.s.normal);
         fill(&mut self.s.node_bend, |k| {
             let (i, dir) = (k / 2, k % 2);
@@ -140,7 +141,9 @@ impl Solver {
             let eta = c0 / l;
             let spindle = regularised(table.bending(mats[i][2 * dir]), stick, band);
             let b = spindle.rigidity();
-            let (m, slope) = if hysteresis && spindle.is_hysteretic() {
+            let (m, slope) = if hysteresis && spindle.is_hysteretic() && steepest {
+                (states[i][2 * dir].moment(&spindle, eta), stick.max(1.0) * b)
+            } else if hysteresis && spindle.is_hysteretic() {
                 let st = &states[i][2 * dir];
                 // The local slope, by a central difference over a small part of the spindle's
                 // reversal width, within the spindle's own bounds [B, stick·B].
