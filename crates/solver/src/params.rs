@@ -300,8 +300,9 @@ pub struct BendingParams {
     /// at the start of the step. A row linearised softer than the reversal chord it then
     /// travels overshoots; on refined grids the cloth flips between two shapes every step and
     /// never rests (`docs/validation.md`, "A period-2 oscillation on refined grids"). Changes
-    /// no equilibrium of a step that ends where it starts. Default false (opt-in until the
-    /// validation is measured with it).
+    /// no equilibrium of a step that ends where it starts. With the exact spindle
+    /// (`stick_slope` ∞) there is no steepest slope and the local one is used. Default false
+    /// (opt-in until the validation is measured with it).
     pub steepest_slope: bool,
     /// Regularisation of the bending hysteresis: the tangent of the spindle's square-root curves
     /// is capped at this multiple of B over a tiny band (`Spindle::with_stick_slope`). Range > 1

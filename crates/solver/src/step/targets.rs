@@ -124,7 +124,9 @@ impl Solver {
         );
         let hysteresis = params.hysteresis && cloth.bending_hysteretic();
         let (stick, band) = (params.bending.stick_slope, params.bending.deadband);
-        let steepest = params.bending.steepest_slope;
+        // The exact spindle (`stick_slope` ∞, or ≤ 1, which `Spindle::with_stick_slope` reads as
+        // ∞) has no steepest slope: its rows keep the local one.
+        let steepest = params.bending.steepest_slope && stick.is_finite() && stick > 1.0;
         let (pos, states, normal) = (&state.positions, &state.bending, &self.s.normal);
         fill(&mut self.s.node_bend, |k| {
             let (i, dir) = (k / 2, k % 2);
@@ -142,7 +144,7 @@ impl Solver {
             let spindle = regularised(table.bending(mats[i][2 * dir]), stick, band);
             let b = spindle.rigidity();
             let (m, slope) = if hysteresis && spindle.is_hysteretic() && steepest {
-                (states[i][2 * dir].moment(&spindle, eta), stick.max(1.0) * b)
+                (states[i][2 * dir].moment(&spindle, eta), stick * b)
             } else if hysteresis && spindle.is_hysteretic() {
                 let st = &states[i][2 * dir];
                 // The local slope, by a central difference over a small part of the spindle's

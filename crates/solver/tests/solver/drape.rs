@@ -470,3 +470,27 @@ fn with_the_steepest_bending_slope_a_refined_drape_comes_to_rest() {
     params.bending.steepest_slope = true;
     assert_no_flip_between_two_shapes(&params, "bending.steepest_slope");
 }
+
+#[test]
+fn the_steepest_slope_leaves_the_exact_spindle_alone() {
+    // With `bending.stick_slope` ∞ the spindle has no steepest slope: the option must not turn
+    // the bending rows rigid (slope ∞, compliance 0) but keep the local slope, bit for bit.
+    let fabric = common::fabric("polyester_faille");
+    let run = |steepest: bool| {
+        let scene = scene(DrapeScene::jis(24, 4), 1);
+        let (cloth, mut state) = scene.build(&fabric).expect("drape scene");
+        let mut solver = Solver::new();
+        let mut params = StepParams::default();
+        params.bending.stick_slope = f64::INFINITY;
+        params.bending.steepest_slope = steepest;
+        for _ in 0..30 {
+            solver
+                .step(&cloth, &mut state, &params, StepInput::default())
+                .expect("drape step");
+        }
+        state.positions
+    };
+    let (local, steepest) = (run(false), run(true));
+    assert!(local.iter().zip(&run(false)).all(|(a, b)| a == b));
+    assert_eq!(local, steepest);
+}
