@@ -143,16 +143,19 @@ impl Solver {
             let eta = c0 / l;
             let spindle = regularised(table.bending(mats[i][2 * dir]), stick, band);
             let b = spindle.rigidity();
-            let (m, slope) = if hysteresis && spindle.is_hysteretic() && steepest {
-                (states[i][2 * dir].moment(&spindle, eta), stick * b)
-            } else if hysteresis && spindle.is_hysteretic() {
+            let (m, slope) = if hysteresis && spindle.is_hysteretic() {
                 let st = &states[i][2 * dir];
-                // The local slope, by a central difference over a small part of the spindle's
-                // reversal width, within the spindle's own bounds [B, stick·B].
-                let h = 1e-3 * spindle.residual_moment() / b;
-                let slope =
-                    (st.moment(&spindle, eta + h) - st.moment(&spindle, eta - h)) / (2.0 * h);
-                (st.moment(&spindle, eta), slope.clamp(b, stick.max(1.0) * b))
+                let slope = if steepest {
+                    stick * b
+                } else {
+                    // The local slope, by a central difference over a small part of the
+                    // spindle's reversal width, within the spindle's own bounds [B, stick·B].
+                    let h = 1e-3 * spindle.residual_moment() / b;
+                    let local =
+                        (st.moment(&spindle, eta + h) - st.moment(&spindle, eta - h)) / (2.0 * h);
+                    local.clamp(b, stick.max(1.0) * b)
+                };
+                (st.moment(&spindle, eta), slope)
             } else {
                 (b * eta, b)
             };
