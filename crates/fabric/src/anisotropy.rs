@@ -120,7 +120,18 @@ pub fn interpolate(
     weft: f64,
     bias: f64,
 ) -> Option<f64> {
-    let (wv, wb, wu) = weights(theta);
+    interpolate_weighted(form, weights(theta), warp, weft, bias)
+}
+
+/// [`interpolate`] with the angle's [`weights`] computed once by the caller (a table of many
+/// values at one angle).
+pub fn interpolate_weighted(
+    form: AnisotropyForm,
+    (wv, wb, wu): (f64, f64, f64),
+    warp: f64,
+    weft: f64,
+    bias: f64,
+) -> Option<f64> {
     let terms = [(wv, warp), (wb, bias), (wu, weft)];
     if terms.iter().any(|t| !t.1.is_finite() || t.1 < 0.0) {
         return None;

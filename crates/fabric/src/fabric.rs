@@ -321,6 +321,12 @@ impl Fabric {
         theta: f64,
         form: AnisotropyForm,
     ) -> Result<(TensileLoop, f64), InvalidValue> {
+        self.tensile_from_knots(theta, form, &self.direction_knots(theta))
+    }
+
+    /// The warp, weft and bias strains (the bias serving `theta`) on both major branches at
+    /// the force knots of the common range: what every angle served by that bias interpolates.
+    fn direction_knots(&self, theta: f64) -> DirectionKnots {
         let d = &self.tensile;
         let bias = d.bias_for(theta);
         let f_max = d
@@ -328,7 +334,38 @@ impl Fabric {
             .max_force()
             .min(d.weft.max_force())
             .min(bias.max_force());
+        let mut strains = [Vec::new(), Vec::new()];
+        for (branch, list) in [Branch::Loading, Branch::Unloading]
+            .into_iter()
+            .zip(strains.iter_mut())
+        {
+            *list = (0..=TABLE_SEGMENTS)
+                .map(|j| {
+                    let a = j as f64 / TABLE_SEGMENTS as f64;
+                    let f = f_max * a * a;
+                    [
+                        d.warp.strain(branch, f),
+                        d.weft.strain(branch, f),
+                        bias.strain(branch, f),
+                    ]
+                })
+                .collect();
+        }
+        DirectionKnots { f_max, strains }
+    }
+
+    /// [`Fabric::tensile_at`] from the directions' knots (`knots` from
+    /// [`Fabric::direction_knots`] at an angle the same bias serves), with the largest
+    /// monotonicity repair over the apex strain.
+    fn tensile_from_knots(
+        &self,
+        theta: f64,
+        form: AnisotropyForm,
+        knots: &DirectionKnots,
+    ) -> Result<(TensileLoop, f64), InvalidValue> {
+        let f_max = knots.f_max;
         let deg = theta.to_degrees();
+        let weights = anisotropy::weights(theta);
         let mut tables = [
             Vec::with_capacity(TABLE_SEGMENTS + 1),
             Vec::with_capacity(TABLE_SEGMENTS + 1),
@@ -336,17 +373,13 @@ impl Fabric {
         for j in 0..=TABLE_SEGMENTS {
             let a = j as f64 / TABLE_SEGMENTS as f64;
             let f = f_max * a * a;
-            for (branch, table) in [Branch::Loading, Branch::Unloading]
+            for ((branch, table), strains) in [Branch::Loading, Branch::Unloading]
                 .into_iter()
                 .zip(tables.iter_mut())
+                .zip(&knots.strains)
             {
-                let v = anisotropy::interpolate(
-                    form.for_tensile(),
-                    theta,
-                    d.warp.strain(branch, f),
-                    d.weft.strain(branch, f),
-                    bias.strain(branch, f),
-                )
+                let [warp, weft, bias] = strains[j];
+                let v = anisotropy::interpolate_weighted(form.for_tensile(), weights, warp, weft, bias)
                 .ok_or_else(|| {
                     InvalidValue::new(
                         ErrorKind::OutOfRange,
@@ -459,6 +492,14 @@ impl Fabric {
     }
 }
 
+/// The warp, weft and bias strains on the loading and unloading branches at the force knots
+/// `f_max·(j/N)²` of one bias side (`Fabric::direction_knots`).
+struct DirectionKnots {
+    f_max: f64,
+    /// Per branch (loading, unloading), per knot: warp, weft, bias.
+    strains: [Vec<[f64; 3]>; 2],
+}
+
 /// The characteristics at every distinct material angle of a grid's edges, built once.
 /// Angles equal modulo 180° (to 1e-9 rad) share an entry.
 #[derive(Clone, Debug)]
@@ -494,6 +535,8 @@ impl MaterialTable {
             bending: Vec::new(),
         };
         let mut indices = Vec::with_capacity(edge_angles.len());
+        // The directions' knots per bias (45°, 135°), made once for all the angles it serves.
+        let mut knots: [Option<DirectionKnots>; 2] = [None, None];
         for (e, &theta) in edge_angles.iter().enumerate() {
             if !theta.is_finite() {
                 return Err(InvalidValue::new(
@@ -509,7 +552,9 @@ impl MaterialTable {
                 Some(&i) => i,
                 None => {
                     let i = table.angles.len() as u32;
-                    let (l, repair) = fabric.tensile_at_repaired(canon, form)?;
+                    let side = usize::from(canon > std::f64::consts::FRAC_PI_2);
+                    let k = knots[side].get_or_insert_with(|| fabric.direction_knots(canon));
+                    let (l, repair) = fabric.tensile_from_knots(canon, form, k)?;
                     table.tensile.push(l);
                     table.repairs.push(repair);
                     table.bending.push(fabric.bending_at(canon, form)?);
