@@ -6,7 +6,7 @@
 //! (s of gravity ramped up from zero first), `support` (hinged or clamped; default the JIS
 //! scene's, clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs), `m0`
 //! (scale of the bending residual moment M₀ alone), `bband` (bending dead band, × M₀/B),
-//! `stick_slope` (bending), `steepest` (0/1: `bending.steepest_slope`), `sband` (shear dead
+//! `stick_slope` (bending), `steepest` (0/1: `bending.steepest_slope`), `spindle_rows` (0/1: `bending.spindle_rows`), `sband` (shear dead
 //! band, rad), `drift` (s stepped after the run, then where the remaining motion is: one step's
 //! move against two steps'). Prints the drape, the convergence counts and the wall time.
 
@@ -122,6 +122,7 @@ fn main() {
             off: get("bending_off", 0.0) != 0.0,
             implicit_stick_slope: get("stick", 0.0) != 0.0,
             steepest_slope: get("steepest", 0.0) != 0.0,
+            spindle_rows: get("spindle_rows", 0.0) != 0.0,
             ..atelier_solver::BendingParams::default()
         },
         ..StepParams::default()

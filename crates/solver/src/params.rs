@@ -304,6 +304,14 @@ pub struct BendingParams {
     /// (`stick_slope` ∞) there is no steepest slope and the local one is used. Default false
     /// (opt-in until the validation is measured with it).
     pub steepest_slope: bool,
+    /// [`BendingModel::Implicit`] with the `Newton` shape method only: read each hysteretic
+    /// bending row on the spindle itself during the solve — the turn at which the spindle,
+    /// from the committed state, gives the moment the row's multiplier exerts, with the
+    /// compliance of its slope there, as an edge's row reads its tensile loop at its own
+    /// force — instead of linearising it at the start of the step (backward Euler in the
+    /// hysteresis; `docs/validation.md`, "Bending rows read on the spindle, session 24").
+    /// Takes precedence over `bending.steepest_slope`. Default false.
+    pub spindle_rows: bool,
     /// Regularisation of the bending hysteresis: the tangent of the spindle's square-root curves
     /// is capped at this multiple of B over a tiny band (`Spindle::with_stick_slope`). Range > 1
     /// (∞ = exact); default 4.
@@ -324,6 +332,7 @@ impl Default for BendingParams {
             max_iterations: 200,
             implicit_stick_slope: false,
             steepest_slope: false,
+            spindle_rows: false,
             stick_slope: 4.0,
             deadband: 0.05,
             off: false,

@@ -7,10 +7,10 @@ use atelier_grid::NO_NODE;
 use super::Solver;
 use super::bending::regularised;
 use super::par::fill;
-use super::projection::{CellShear, NodeBend, edge_strain};
+use super::projection::{CellShear, NodeBend, SpindleRow, edge_strain};
 use crate::bend_angle::{turn_and_gradient, turn_axis};
 use crate::cloth::Cloth;
-use crate::params::{BendingModel, StepParams};
+use crate::params::{BendingModel, ShapeMethod, StepParams};
 use crate::shear_angle::cell_angle;
 use crate::state::ClothState;
 
@@ -127,6 +127,8 @@ impl Solver {
         // The exact spindle (`stick_slope` ∞, or ≤ 1, which `Spindle::with_stick_slope` reads as
         // ∞) has no steepest slope: its rows keep the local one.
         let steepest = params.bending.steepest_slope && stick.is_finite() && stick > 1.0;
+        let spindle_rows =
+            params.bending.spindle_rows && params.shape.method == ShapeMethod::Newton;
         let (pos, states, normal) = (&state.positions, &state.bending, &self.s.normal);
         fill(&mut self.s.node_bend, |k| {
             let (i, dir) = (k / 2, k % 2);
@@ -143,6 +145,13 @@ impl Solver {
             let eta = c0 / l;
             let spindle = regularised(table.bending(mats[i][2 * dir]), stick, band);
             let b = spindle.rigidity();
+            let spindle_row =
+                (spindle_rows && hysteresis && spindle.is_hysteretic()).then(|| SpindleRow {
+                    spindle,
+                    state: states[i][2 * dir],
+                    length: l,
+                    area: areas[i],
+                });
             let (m, slope) = if hysteresis && spindle.is_hysteretic() {
                 let st = &states[i][2 * dir];
                 let slope = if steepest {
@@ -163,6 +172,7 @@ impl Solver {
                 axis,
                 offset: c0 - m * l / slope,
                 compliance: l * l / (slope * areas[i]),
+                spindle_row,
             }
         });
     }

@@ -472,6 +472,16 @@ fn with_the_steepest_bending_slope_a_refined_drape_comes_to_rest() {
 }
 
 #[test]
+fn with_bending_rows_read_on_the_spindle_a_refined_drape_comes_to_rest() {
+    // The opt-in `bending.spindle_rows` (session 24): each hysteretic bending row read on the
+    // spindle during the solve (backward Euler in the hysteresis) instead of linearised at the
+    // start of the step; the same scene and goal as the two tests above.
+    let mut params = StepParams::default();
+    params.bending.spindle_rows = true;
+    assert_no_flip_between_two_shapes(&params, "bending.spindle_rows");
+}
+
+#[test]
 fn the_steepest_slope_leaves_the_exact_spindle_alone() {
     // With `bending.stick_slope` ∞ the spindle has no steepest slope: the option must not turn
     // the bending rows rigid (slope ∞, compliance 0) but keep the local slope, bit for bit.

@@ -42,6 +42,9 @@ mod contacts;
 mod local;
 mod newton;
 mod rows;
+mod spindle_row;
+
+pub use spindle_row::SpindleRow;
 
 /// Below this many rows, loops run on one thread.
 const PAR_MIN: usize = 2048;
@@ -119,6 +122,9 @@ pub struct NodeBend {
     /// Compliance l̄²/(k·S) (k the spindle's local slope, N·m; S the node's area; l̄ the mean
     /// rest length of the two edges).
     pub compliance: f64,
+    /// With `bending.spindle_rows`, for a hysteretic row: the spindle read during the solve
+    /// instead of the linearisation above.
+    pub spindle_row: Option<SpindleRow>,
 }
 
 /// The axial edges' tensile characteristics, for [`Tension::Constraint`]: each edge's target

@@ -152,7 +152,22 @@ impl ShapeSolver {
                     for k in 0..3 {
                         g[slot[k] as usize] += grad[k];
                     }
-                    (theta - bend.offset, bend.compliance / dt2, false, 1.0, true)
+                    match &bend.spindle_row {
+                        None => (theta - bend.offset, bend.compliance / dt2, false, 1.0, true),
+                        // The turn at which the spindle gives the row's moment (the target
+                        // follows λ, as an edge's does), the compliance from its slope there.
+                        Some(row) => {
+                            let (eta, slope) = row.curvature_at(row.moment(lam, dt));
+                            let compliance = row.length * row.length / (slope * row.area);
+                            (
+                                theta - row.length * eta,
+                                compliance / dt2,
+                                false,
+                                1.0,
+                                false,
+                            )
+                        }
+                    }
                 }
                 RowKind::Tie(t) => {
                     let tie = &ties[tie_index[t as usize] as usize];
@@ -185,7 +200,13 @@ impl ShapeSolver {
             let active = !inequality || value > 0.0 || lam < 0.0;
             // Rows whose compliance lives in their value (edges: the target follows λ) take
             // no α̃λ term in their residual.
-            let implicit_target = matches!(kinds[r], RowKind::Edge(_));
+            let implicit_target = match kinds[r] {
+                RowKind::Edge(_) => true,
+                RowKind::Bend(i, dir, _) => {
+                    p.bends[2 * i as usize + dir as usize].spindle_row.is_some()
+                }
+                RowKind::Cell(_) | RowKind::Tie(_) => false,
+            };
             *c = value;
             if !active {
                 for gk in g.iter_mut() {
