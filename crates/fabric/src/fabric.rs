@@ -379,14 +379,16 @@ impl Fabric {
                 .zip(&knots.strains)
             {
                 let [warp, weft, bias] = strains[j];
-                let v = anisotropy::interpolate_weighted(form.for_tensile(), weights, warp, weft, bias)
-                .ok_or_else(|| {
-                    InvalidValue::new(
-                        ErrorKind::OutOfRange,
-                        "tensile",
-                        format!("the {form:?} form gives no positive strain at θ = {deg:.2}°, f = {f:.4} N/m ({branch:?})"),
-                    )
-                })?;
+                let tensile_form = form.for_tensile();
+                let Some(v) =
+                    anisotropy::interpolate_weighted(tensile_form, weights, warp, weft, bias)
+                else {
+                    let message = format!(
+                        "the {form:?} form gives no positive strain at θ = {deg:.2}°, \
+                         f = {f:.4} N/m ({branch:?})"
+                    );
+                    return Err(InvalidValue::new(ErrorKind::OutOfRange, "tensile", message));
+                };
                 table.push(v);
             }
         }

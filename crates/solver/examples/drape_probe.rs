@@ -6,9 +6,10 @@
 //! (s of gravity ramped up from zero first), `support` (hinged or clamped; default the JIS
 //! scene's, clamped), `hysteresis` (0/1), `method` (direct, cg, jacobi, chebyshev, gs), `m0`
 //! (scale of the bending residual moment M₀ alone), `bband` (bending dead band, × M₀/B),
-//! `stick_slope` (bending), `steepest` (0/1: `bending.steepest_slope`), `spindle_rows` (0/1: `bending.spindle_rows`), `sband` (shear dead
-//! band, rad), `drift` (s stepped after the run, then where the remaining motion is: one step's
-//! move against two steps'). Prints the drape, the convergence counts and the wall time.
+//! `stick_slope` (bending), `steepest` (0/1: `bending.steepest_slope`), `spindle_rows` (0/1:
+//! `bending.spindle_rows`), `sband` (shear dead band, rad), `drift` (s stepped after the run,
+//! then where the remaining motion is: one step's move against two steps'). Prints the drape,
+//! the convergence counts and the wall time.
 
 use std::time::Instant;
 
