@@ -74,7 +74,7 @@ pub struct Directions<T> {
 impl<T> Directions<T> {
     /// The bias value that serves angle `theta` (rad): 45° for θ mod 180° ≤ 90°, else 135°.
     pub fn bias_for(&self, theta: f64) -> &T {
-        if canonical_angle(theta) <= std::f64::consts::FRAC_PI_2 {
+        if bias_side(theta) == 0 {
             &self.bias45
         } else {
             &self.bias135
@@ -90,6 +90,11 @@ impl<T> Directions<T> {
             bias135: f(&self.bias135),
         }
     }
+}
+
+/// Which bias serves angle `theta` (rad): 0 for 45° (θ mod 180° ≤ 90°), 1 for 135°.
+pub fn bias_side(theta: f64) -> usize {
+    usize::from(canonical_angle(theta) > std::f64::consts::FRAC_PI_2)
 }
 
 /// θ reduced to [0, π): the characteristic of a line does not depend on its orientation.

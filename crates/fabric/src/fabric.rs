@@ -554,7 +554,7 @@ impl MaterialTable {
                 Some(&i) => i,
                 None => {
                     let i = table.angles.len() as u32;
-                    let side = usize::from(canon > std::f64::consts::FRAC_PI_2);
+                    let side = anisotropy::bias_side(canon);
                     let k = knots[side].get_or_insert_with(|| fabric.direction_knots(canon));
                     let (l, repair) = fabric.tensile_from_knots(canon, form, k)?;
                     table.tensile.push(l);
