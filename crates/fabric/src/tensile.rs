@@ -209,6 +209,18 @@ impl TensileLoop {
                 ));
             }
         }
+        // Departures within the rounding tolerances above are repaired, so that the table keeps
+        // its invariants exactly: each branch non-decreasing, the unloading branch never below the
+        // loading one (a strain on the major loop then lies inside it, as the model promises).
+        let (mut load, mut unload) = (load, unload);
+        for tab in [&mut load, &mut unload] {
+            for j in 1..=n {
+                tab[j] = tab[j].max(tab[j - 1]);
+            }
+        }
+        for (u, &l) in unload.iter_mut().zip(&load) {
+            *u = u.max(l);
+        }
         Ok(Self {
             f_max,
             inv_f_max: 1.0 / f_max,
