@@ -150,6 +150,16 @@ impl SpindleRow {
 mod tests {
     use super::*;
 
+    /// A row of a 1 cm line on a 1 cm² node.
+    fn test_row(spindle: Spindle, state: BendingState) -> SpindleRow {
+        SpindleRow {
+            spindle,
+            state,
+            length: 0.01,
+            area: 1e-4,
+        }
+    }
+
     /// The inversion gives back curvatures the spindle was read at, on the initial curve,
     /// after a reversal and on the far side of the loop.
     #[test]
@@ -161,12 +171,7 @@ mod tests {
         let mut state = BendingState::VIRGIN;
         for eta in [0.0, 3.0, 1.0, -2.0] {
             state.update(&spindle, eta);
-            let row = SpindleRow {
-                spindle,
-                state,
-                length: 0.01,
-                area: 1e-4,
-            };
+            let row = test_row(spindle, state);
             for target in [-4.0, -0.3, 0.0, 0.02, 0.7, 5.0] {
                 let m = state.moment(&spindle, target);
                 let (back, slope) = row.curvature_at(m);
@@ -196,12 +201,7 @@ mod tests {
         for eta in [3.0, 1.0] {
             state.update(&spindle, eta);
         }
-        let row = SpindleRow {
-            spindle,
-            state,
-            length: 0.01,
-            area: 1e-4,
-        };
+        let row = test_row(spindle, state);
         let eta0 = 1.0;
         let w = KINK_HALF_WIDTH * m0 / b;
         let one_sided =
@@ -214,9 +214,10 @@ mod tests {
             "reversal slope {back}"
         );
         for x in [-2.0 * w, -w, w, 1.5 * w, 0.3, -0.5] {
+            // Exactly the spindle's, bit for bit.
             assert_eq!(
-                row.moment_at(eta0 + x),
-                state.moment(&spindle, eta0 + x),
+                row.moment_at(eta0 + x).to_bits(),
+                state.moment(&spindle, eta0 + x).to_bits(),
                 "at {x}"
             );
         }
