@@ -97,3 +97,23 @@ pub fn closest_point(p: &V3, x: [&V3; 3]) -> (V3, [f64; 3]) {
     let (v, w) = (vb * denom, vc * denom);
     (a + ab * v + ac * w, [1.0 - v - w, v, w])
 }
+
+/// Where the line `p + s·n` meets the triangle `x` (edges included; Möller–Trumbore): `s`, or
+/// `None` when it misses or runs parallel to the triangle's plane.
+pub fn line_triangle(p: &V3, n: &V3, x: [&V3; 3]) -> Option<f64> {
+    let e1 = x[1] - x[0];
+    let e2 = x[2] - x[0];
+    let h = n.cross(&e2);
+    let det = e1.dot(&h);
+    if det.abs() <= 1e-14 * e1.norm() * e2.norm() * n.norm() {
+        return None;
+    }
+    let to = p - x[0];
+    let u = to.dot(&h) / det;
+    let q = to.cross(&e1);
+    let w = n.dot(&q) / det;
+    if u < 0.0 || w < 0.0 || u + w > 1.0 {
+        return None;
+    }
+    Some(e2.dot(&q) / det)
+}

@@ -25,6 +25,7 @@ pub mod metrics;
 pub mod params;
 pub mod scenes;
 pub mod shear_angle;
+pub mod show_through;
 pub mod state;
 pub mod step;
 pub mod wet;

@@ -401,6 +401,20 @@ fn garment_simulated(run: crate::pipeline::GarmentRun, dt: f64) -> Simulated {
     });
     put("hem_width_m", hem.map(|h| h.width));
     put("hem_depth_m", hem.map(|h| h.depth));
+    let showing = run.frames.last().map(|f| {
+        atelier_solver::show_through::show_through(
+            &f.body,
+            &run.body_triangles,
+            &f.cloth,
+            &run.cloth_triangles,
+            atelier_solver::show_through::SHOW_THROUGH_REACH,
+        )
+    });
+    put(
+        "body_vertices_showing",
+        showing.as_ref().map(|s| s.vertices.len() as f64),
+    );
+    put("body_showing_depth_m", showing.map(|s| s.deepest));
     put("final_rms_speed_m_s", speed);
     Simulated {
         fabric: String::new(),

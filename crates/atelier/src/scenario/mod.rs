@@ -129,6 +129,8 @@ impl ScenarioKind {
                 "nodes_below_body",
                 "hem_width_m",
                 "hem_depth_m",
+                "body_vertices_showing",
+                "body_showing_depth_m",
                 "final_rms_speed_m_s",
                 "frames",
                 crate::convergence::UNCONVERGED_FRACTION,
