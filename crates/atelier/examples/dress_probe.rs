@@ -43,7 +43,7 @@ fn main() {
                 }
                 if std::env::var("PROBE_STEPS").is_ok() {
                     println!(
-                        "step t={:.2} inside {} sub {} it {} fact {} conv {} viol {:.1e} worst {:?} self hits {} planes {} {:.2}s",
+                        "step t={:.2} inside {} sub {} it {} fact {} conv {} viol {:.1e} worst {:?} self hits {} planes {} vertex planes {} {:.2}s",
                         sim.time(),
                         o.inside,
                         o.substeps,
@@ -54,6 +54,7 @@ fn main() {
                         o.report.worst,
                         o.contacts.self_hits,
                         o.contacts.planes,
+                        o.contacts.vertex_planes,
                         wall.elapsed().as_secs_f64()
                     );
                 }

@@ -347,3 +347,81 @@ fn a_node_slightly_inside_the_body_is_moved_out_within_the_step() {
         }
     }
 }
+
+/// A low square pyramid (base ±5 cm at z = 0, apex 1 cm up) closed by its base, and a square
+/// sheet of two triangles 8 mm up, corners at (±2, ±2) cm: every corner is 2 mm above the
+/// pyramid's face, so node contact leaves the sheet where it is, while the apex pokes 2 mm
+/// through the sheet's diagonal. Returns the sheet's height over the apex after each node is
+/// moved onto its plane where it lies behind it (what the shape solve does), the nodes that
+/// had a plane, and the nodes whose plane the apex lifted.
+fn sheet_over_the_apex(params: ContactParams) -> (f64, usize, usize) {
+    let body = vec![
+        V3::new(-0.05, -0.05, 0.0),
+        V3::new(0.05, -0.05, 0.0),
+        V3::new(0.05, 0.05, 0.0),
+        V3::new(-0.05, 0.05, 0.0),
+        V3::new(0.0, 0.0, 0.01),
+    ];
+    let tris = vec![
+        [0, 1, 4],
+        [1, 2, 4],
+        [2, 3, 4],
+        [3, 0, 4],
+        [0, 2, 1],
+        [0, 3, 2],
+    ];
+    let mut c = Collider::new(params).expect("params");
+    c.set_body(&body, &body, &tris, 1e-3).expect("body");
+    let mut x = vec![
+        V3::new(-0.02, -0.02, 0.008),
+        V3::new(0.02, -0.02, 0.008),
+        V3::new(0.02, 0.02, 0.008),
+        V3::new(-0.02, 0.02, 0.008),
+    ];
+    let sheet = [[0u32, 1, 2], [0, 2, 3]];
+    let mut vel = vec![V3::zeros(); 4];
+    let inv = [1.0; 4];
+    let mut planes = vec![atelier_collide::ContactPlane::default(); 4];
+    c.transfer(&x, &mut vel, &inv, &[], &mut planes);
+    let own = planes.iter().filter(|p| p.normal != V3::zeros()).count();
+    let lifted = c.vertex_planes(&x, &inv, &sheet, &mut planes);
+    for (xi, p) in x.iter_mut().zip(&planes) {
+        let d = (*xi - p.point).dot(&p.normal);
+        if d < 0.0 {
+            *xi -= p.normal * d;
+        }
+    }
+    // The sheet's height at the apex's (x, y) = (0, 0), on the diagonal 0–2, along the apex's
+    // normal (+z).
+    let height = 0.5 * (x[0].z + x[2].z) - 0.01;
+    (height, own, lifted)
+}
+
+#[test]
+fn a_body_vertex_under_a_cloth_triangle_lifts_the_triangle_over_it() {
+    let base = ContactParams {
+        staged: false,
+        ..ContactParams::default()
+    };
+    // Node contact alone: all four nodes have a plane and lie in front of it; the apex stays
+    // 2 mm through the sheet.
+    let off = ContactParams {
+        vertex_planes: false,
+        ..base
+    };
+    let (height, own, lifted) = sheet_over_the_apex(off);
+    assert_eq!((own, lifted), (4, 0));
+    assert!((height + 0.002).abs() < 1e-12, "{height}");
+    // With body-vertex planes the sheet clears the apex by the skin.
+    let (height, own, lifted) = sheet_over_the_apex(base);
+    // The two nodes of the diagonal the apex's line meets; the other two weigh nothing there.
+    assert_eq!((own, lifted), (4, 2));
+    assert!((height - base.thickness).abs() < 1e-12, "{height}");
+    // One-sided contact (a garment passing through the body): nothing lifted.
+    let one_sided = ContactParams {
+        one_sided: true,
+        ..base
+    };
+    let (_, _, lifted) = sheet_over_the_apex(one_sided);
+    assert_eq!(lifted, 0);
+}

@@ -126,6 +126,12 @@ impl CollisionHook for BodyContact {
             &self.normals,
             ctx.planes,
         );
+        self.collider.vertex_planes(
+            ctx.positions,
+            ctx.inverse_masses,
+            &self.triangles,
+            ctx.planes,
+        );
     }
 
     fn resolve(&mut self, ctx: HookContext<'_>) {

@@ -11,6 +11,7 @@ use atelier::report::Report;
 use atelier::run::{RunOptions, run};
 use atelier::scenario::{Scenario, ScenarioKind};
 use atelier::{ClothSolver, Scene, Simulation};
+use atelier_solver::show_through::{SHOW_THROUGH_REACH, show_through};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -56,6 +57,32 @@ fn the_dress_is_sewn_on_the_mannequin_without_entering_it() {
     let hem = last.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
     assert!((1.28..1.42).contains(&top), "top of the dress at {top} m");
     assert!((0.30..0.45).contains(&hem), "hem at {hem} m");
+    // The faces between the nodes stay outside the body too (body-vertex planes,
+    // docs/collision.md §4c), measured by a ray test of the final shape. Node contact alone
+    // left 13 body vertices showing, up to 4.3 mm (the shoulder points and the bust). The goal,
+    // none, is missed: 3 vertices at up to 0.87 mm here (docs/validation.md, "The body through
+    // the cloth's faces"). The bound, chosen after that measurement and disclosed there, is a
+    // third of the 3 mm skin the lift aims at — a fraction of a pixel in the report's pictures
+    // (3.6 mm a pixel) — so a return to the node contact alone fails it.
+    let f = run.frames.last().expect("frames");
+    let showing = show_through(
+        &f.body,
+        &run.body_triangles,
+        &f.cloth,
+        &run.cloth_triangles,
+        SHOW_THROUGH_REACH,
+    );
+    assert!(
+        showing.deepest < 1e-3,
+        "{} body vertices show through the cloth, up to {:.2} mm: {:?}",
+        showing.vertices.len(),
+        showing.deepest * 1e3,
+        showing
+            .vertices
+            .iter()
+            .map(|&v| f.body[v as usize])
+            .collect::<Vec<_>>()
+    );
 }
 
 /// The same dress through `atelier run`: the report's fields, and every output written.

@@ -22,6 +22,9 @@ use node::{
 
 mod node;
 mod params;
+mod vertex;
+
+use vertex::vertex_normals;
 
 /// The cloth as a collision pass sees it.
 pub struct ClothView<'a> {
@@ -64,6 +67,8 @@ pub struct PassStats {
     /// Nodes given a contact plane for the shape iterations (within `plane_reach` of the body,
     /// or inside it, at the start of the step).
     pub planes: usize,
+    /// Node planes lifted over a body vertex.
+    pub vertex_planes: usize,
 }
 
 struct Body {
@@ -74,6 +79,7 @@ struct Body {
     /// Vertex velocity over the previous step (zero before the first).
     prev_vel: Vec<V3>,
     triangles: Vec<[u32; 3]>,
+    end_normals: Vec<V3>,
     broad: Box<dyn BroadPhase>,
     max_displacement: f64,
 }
@@ -177,6 +183,7 @@ impl Collider {
                 vel: vec![V3::zeros(); start.len()],
                 prev_vel: vec![V3::zeros(); start.len()],
                 triangles: triangles.to_vec(),
+                end_normals: Vec::new(),
                 broad: new_broad(self.params.broad),
                 max_displacement: 0.0,
             });
@@ -191,6 +198,7 @@ impl Collider {
         let inv_dt = if dt > 0.0 { 1.0 / dt } else { 0.0 };
         body.vel
             .extend(start.iter().zip(end).map(|(a, b)| (b - a) * inv_dt));
+        vertex_normals(end, triangles, &mut body.end_normals);
         body.max_displacement = start
             .iter()
             .zip(end)

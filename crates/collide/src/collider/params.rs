@@ -41,6 +41,8 @@ pub struct ContactParams {
     /// constraint that every shape iteration respects, so the cloth's constraints and the
     /// contact are solved together instead of in turn. 0 turns it off. Default 0.01 m.
     pub plane_reach: f64,
+    /// Body vertices against the cloth's triangles (addition): see `Collider::vertex_planes`.
+    pub vertex_planes: bool,
 }
 
 /// A one-sided contact constraint for one node: its position at the end of the step must
@@ -73,6 +75,7 @@ impl Default for ContactParams {
             narrow: NarrowTest::Exact,
             recovery_depth: 5e-3,
             plane_reach: 0.01,
+            vertex_planes: true,
         }
     }
 }
