@@ -117,3 +117,23 @@ pub fn line_triangle(p: &V3, n: &V3, x: [&V3; 3]) -> Option<f64> {
     }
     Some(e2.dot(&q) / det)
 }
+
+/// Unit area-weighted vertex normals of `triangles` at `positions` into `out` (zero for a
+/// vertex in no triangle).
+pub fn vertex_normals(positions: &[V3], triangles: &[[u32; 3]], out: &mut Vec<V3>) {
+    out.clear();
+    out.resize(positions.len(), V3::zeros());
+    for t in triangles {
+        let [a, b, c] = t.map(|k| positions[k as usize]);
+        let n = (b - a).cross(&(c - a));
+        for &k in t {
+            out[k as usize] += n;
+        }
+    }
+    for n in out.iter_mut() {
+        let len = n.norm();
+        if len > 0.0 {
+            *n /= len;
+        }
+    }
+}

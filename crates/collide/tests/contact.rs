@@ -401,6 +401,7 @@ fn sheet_over_the_apex(params: ContactParams) -> (f64, usize, usize) {
 fn a_body_vertex_under_a_cloth_triangle_lifts_the_triangle_over_it() {
     let base = ContactParams {
         staged: false,
+        vertex_planes: true,
         ..ContactParams::default()
     };
     // Node contact alone: all four nodes have a plane and lie in front of it; the apex stays

@@ -1,6 +1,7 @@
 //! The collision hook the step calls: [`atelier_collide::Collider`] adapted to a [`Cloth`] — its
 //! triangles for self-collision, its node normals for one-sided contact, its inverse masses.
 
+use atelier_collide::geom::vertex_normals;
 use atelier_collide::parts::Motion;
 use atelier_collide::{
     ClothView, Collider, ContactError, ContactParams, PassStats, RigidParts, V3,
@@ -94,21 +95,7 @@ impl BodyContact {
 
     /// Area-weighted node normals of the cloth at `positions` (for one-sided contact).
     fn update_normals(&mut self, positions: &[V3]) {
-        self.normals.clear();
-        self.normals.resize(positions.len(), V3::zeros());
-        for t in &self.triangles {
-            let [a, b, c] = t.map(|k| positions[k as usize]);
-            let n = (b - a).cross(&(c - a));
-            for &k in t {
-                self.normals[k as usize] += n;
-            }
-        }
-        for n in &mut self.normals {
-            let len = n.norm();
-            if len > 0.0 {
-                *n /= len;
-            }
-        }
+        vertex_normals(positions, &self.triangles, &mut self.normals);
     }
 }
 

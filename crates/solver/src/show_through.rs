@@ -16,7 +16,7 @@
 
 use atelier_collide::V3;
 use atelier_collide::broad::{BroadKind, new_broad};
-use atelier_collide::geom::line_triangle;
+use atelier_collide::geom::{line_triangle, vertex_normals};
 
 /// How far along a body vertex's normal the cloth is looked for, on either side, m.
 pub const SHOW_THROUGH_REACH: f64 = 0.02;
@@ -51,24 +51,16 @@ pub fn show_through(
     }
     let body: Vec<V3> = body.iter().map(|p| V3::from(*p)).collect();
     let cloth: Vec<V3> = cloth.iter().map(|p| V3::from(*p)).collect();
-    let mut normals = vec![V3::zeros(); body.len()];
-    for t in body_triangles {
-        let [a, b, c] = t.map(|k| body[k as usize]);
-        let n = (b - a).cross(&(c - a));
-        for &k in t {
-            normals[k as usize] += n;
-        }
-    }
+    let mut normals = Vec::new();
+    vertex_normals(&body, body_triangles, &mut normals);
     let mut broad = new_broad(BroadKind::Bvh);
     broad.update(&cloth, &cloth, cloth_triangles, 0.0);
     let mut out = ShowThrough::default();
     let mut candidates = Vec::new();
-    for (v, (p, n)) in body.iter().zip(&normals).enumerate() {
-        let len = n.norm();
-        if len == 0.0 {
+    for (v, (p, &n)) in body.iter().zip(&normals).enumerate() {
+        if n == V3::zeros() {
             continue;
         }
-        let n = n / len;
         candidates.clear();
         broad.query(&(p - n * reach), &(p + n * reach), 0.0, &mut candidates);
         let (mut front, mut behind) = (false, f64::INFINITY);

@@ -203,6 +203,7 @@ impl Simulation {
             thickness: settings.skin,
             staged: settings.staged,
             one_sided,
+            vertex_planes: settings.vertex_planes,
             ..ContactParams::default()
         };
         let mut contact = BodyContact::new(&g.cloth.cloth, contact_params)?;

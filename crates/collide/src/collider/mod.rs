@@ -24,7 +24,7 @@ mod node;
 mod params;
 mod vertex;
 
-use vertex::vertex_normals;
+use crate::geom::vertex_normals;
 
 /// The cloth as a collision pass sees it.
 pub struct ClothView<'a> {
@@ -198,7 +198,9 @@ impl Collider {
         let inv_dt = if dt > 0.0 { 1.0 / dt } else { 0.0 };
         body.vel
             .extend(start.iter().zip(end).map(|(a, b)| (b - a) * inv_dt));
-        vertex_normals(end, triangles, &mut body.end_normals);
+        if self.params.vertex_planes {
+            vertex_normals(end, triangles, &mut body.end_normals);
+        }
         body.max_displacement = start
             .iter()
             .zip(end)

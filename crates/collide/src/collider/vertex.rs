@@ -9,12 +9,14 @@
 //! Once per step, after the nodes' own planes are set (the transfer), every cloth triangle with
 //! a node that has a plane is tested against the body vertices near it (the body's broad phase
 //! around the triangle): where the line through a body vertex along its normal (end of step)
-//! meets the triangle (the nodes at the start of the step) less than the skin in front of the
-//! vertex — or behind it, by less than half the triangle's longest edge — the triangle is
-//! `short` of the skin there. Its height at that point, Σ wₖ hₖ (barycentric weights), grows by
-//! `short` when each node moves wₖ·short/Σw² along the vertex's normal, the least such motion;
-//! each node's own plane is moved that far (divided by the cosine between the two normals)
-//! beyond where the node is, so the shape solve lifts it. A node keeps its own normal: a plane
+//! meets the triangle (the nodes at the start of the step) less than `plane_reach` in front of
+//! the vertex — or behind it, by less than half the triangle's longest edge — the triangle is
+//! `short` of the skin there (negative when it is farther). Its height at that point, Σ wₖ hₖ
+//! (barycentric weights), grows by `short` when each node moves wₖ·short/Σw² along the
+//! vertex's normal, the least such motion; each node's own plane is moved to that far
+//! (divided by the cosine between the two normals) beyond where the node is, when that is in
+//! front of the plane: the shape solve lifts a node short of it, and holds one with slack from
+//! sagging further than its share. A node keeps its own normal: a plane
 //! per node, never two, and no node loses the contact that holds it. Nodes whose own normal
 //! differs from the vertex's by more than 60°, and nodes without a plane, are left alone; a
 //! node met again in a collision pass takes that contact's plane (unlifted).
@@ -23,7 +25,11 @@
 //! giving the nodes the vertex's plane in place of their own, or lifting their planes after
 //! every collision pass from their predicted end positions. Both left steps unconverged (plane
 //! rows at up to 0.4) and multiplied the shape iterations; the once-per-step lift from the
-//! start positions kept every step converged.
+//! start positions kept every step converged. Lifting only where the face is already short
+//! (no hold) kicked the face up every few steps: the sewn silk skirt did not come to rest.
+//!
+//! Off by default (`ContactParams::vertex_planes`): with it the sewn skirt in cotton broad does
+//! not come to rest either (`docs/validation.md`, "The body through the cloth's faces").
 
 use crate::geom::{V3, line_triangle};
 use crate::narrow::barycentric;
@@ -33,26 +39,6 @@ use super::{Collider, ContactPlane};
 /// Least cosine between a body vertex's normal and a cloth triangle's (either side), and
 /// between the vertex's normal and the own plane normal of a node it lifts.
 const AGREE: f64 = 0.5;
-
-/// Unit area-weighted vertex normals of `triangles` at `positions` into `out` (zero for a
-/// vertex in no triangle).
-pub(super) fn vertex_normals(positions: &[V3], triangles: &[[u32; 3]], out: &mut Vec<V3>) {
-    out.clear();
-    out.resize(positions.len(), V3::zeros());
-    for t in triangles {
-        let [a, b, c] = t.map(|k| positions[k as usize]);
-        let n = (b - a).cross(&(c - a));
-        for &k in t {
-            out[k as usize] += n;
-        }
-    }
-    for n in out.iter_mut() {
-        let len = n.norm();
-        if len > 0.0 {
-            *n /= len;
-        }
-    }
-}
 
 impl Collider {
     /// Lift the contact planes of the cloth's nodes at `positions` (start of step) where a body
@@ -116,10 +102,13 @@ impl Collider {
                 let Some(s) = line_triangle(&q, &n, [&x[0], &x[1], &x[2]]) else {
                     continue;
                 };
-                let short = p.thickness - s;
-                if short <= 0.0 || s < -0.5 * longest {
+                if s >= p.plane_reach || s < -0.5 * longest {
                     continue;
                 }
+                // Negative where the face is more than the skin in front of the vertex: then
+                // the lifted plane lies behind the node and holds it from sagging further
+                // than its share of that slack.
+                let short = p.thickness - s;
                 let h = q + n * s;
                 let w = barycentric(&h, [&x[0], &x[1], &x[2]]);
                 let w2: f64 = w.iter().map(|a| a * a).sum();
