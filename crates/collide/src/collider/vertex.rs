@@ -13,11 +13,11 @@
 //! the vertex — or behind it, by less than half the triangle's longest edge — the triangle is
 //! `short` of the skin there (negative when it is farther). Its height at that point, Σ wₖ hₖ
 //! (barycentric weights), grows by `short` when each node moves wₖ·short/Σw² along the
-//! vertex's normal, the least such motion; each node's own plane is moved to that far
+//! vertex's normal, the least such motion; each node's own plane is moved to lie that far
 //! (divided by the cosine between the two normals) beyond where the node is, when that is in
 //! front of the plane: the shape solve lifts a node short of it, and holds one with slack from
-//! sagging further than its share. A node keeps its own normal: a plane
-//! per node, never two, and no node loses the contact that holds it. Nodes whose own normal
+//! sagging further than its share. A node keeps its own normal: a plane per node, never two,
+//! and no node loses the contact that holds it. Nodes whose own normal
 //! differs from the vertex's by more than 60°, and nodes without a plane, are left alone; a
 //! node met again in a collision pass takes that contact's plane (unlifted).
 //!
