@@ -1,4 +1,4 @@
-//! How `cargo test` runs the scenarios: the four lists of `fixtures/scenarios/CI.md` (each
+//! How `cargo test` runs the scenarios: the five lists of `fixtures/scenarios/CI.md` (each
 //! `- name` line under its heading), read by the tests below and by `run-scenarios` for the
 //! column "in CI" of `docs/results.md`. Every scenario file must be in exactly one list, so none
 //! is left out silently.
@@ -17,6 +17,9 @@
 //!   ran out of its 90 minutes; `docs/validation.md`, "What CI runs").
 //! - *Known misses:* scenarios whose shortened form already misses (the reason and number are
 //!   in the file); not run by `cargo test`.
+//! - *In full by another test:* a scenario another test of `cargo test` runs in full with every
+//!   expectation of its file asserted (the README's `default`, run by the command-line test of
+//!   `atelier` with no arguments); xtask's tests leave it to that test.
 //!
 //! A scenario's expectations are checked for binding when the file is read (an interval covering
 //! the metric's whole physical range is refused, `atelier::scenario::bounds`), so a scenario that
@@ -31,8 +34,9 @@ use atelier::scenario::{Scenario, ScenarioKind};
 /// The file holding the lists, relative to the repository.
 pub const FILE: &str = "fixtures/scenarios/CI.md";
 
-/// The four lists: run in full by `cargo test`, run by it shortened, run shortened by the long
-/// tests, not run by either.
+/// The five lists: run in full by `cargo test`, run by it shortened, run shortened by the long
+/// tests, not run by either, and run in full by another test of `cargo test` (named in the
+/// file; xtask's tests leave them to it).
 pub struct Lists {
     /// Run in full by `cargo test`.
     pub full: Vec<String>,
@@ -42,6 +46,8 @@ pub struct Lists {
     pub later: Vec<String>,
     /// Known misses: not run by `cargo test` (each with its reason and number in the file).
     pub misses: Vec<String>,
+    /// Run in full by another test of `cargo test`, which asserts every expectation of the file.
+    pub elsewhere: Vec<String>,
 }
 
 impl Lists {
@@ -49,7 +55,7 @@ impl Lists {
     /// `cargo xtask long-tests`) or "–".
     pub fn in_ci(&self, name: &str) -> &'static str {
         let has = |l: &[String]| l.iter().any(|n| n == name);
-        if has(&self.full) {
+        if has(&self.full) || has(&self.elsewhere) {
             "in full"
         } else if has(&self.long) {
             "shortened"
@@ -61,7 +67,7 @@ impl Lists {
     }
 }
 
-/// Read the four lists.
+/// Read the five lists.
 pub fn lists(root: &Path) -> Result<Lists> {
     let path = root.join(FILE);
     let text =
@@ -71,6 +77,7 @@ pub fn lists(root: &Path) -> Result<Lists> {
         long: Vec::new(),
         later: Vec::new(),
         misses: Vec::new(),
+        elsewhere: Vec::new(),
     };
     let mut section = 0;
     for (n, line) in text.lines().enumerate() {
@@ -87,7 +94,8 @@ pub fn lists(root: &Path) -> Result<Lists> {
                 2 => lists.long.push(name),
                 3 => lists.later.push(name),
                 4 => lists.misses.push(name),
-                _ => bail!("{FILE}:{}: a list item outside the four sections", n + 1),
+                5 => lists.elsewhere.push(name),
+                _ => bail!("{FILE}:{}: a list item outside the five sections", n + 1),
             }
         }
     }
@@ -166,7 +174,7 @@ mod tests {
         let l = lists(&root).expect("CI.md");
         assert!(l.full.len() >= 10, "{:?}", l.full);
         for name in &names {
-            let found = [&l.full, &l.long, &l.later, &l.misses]
+            let found = [&l.full, &l.long, &l.later, &l.misses, &l.elsewhere]
                 .iter()
                 .filter(|list| list.contains(name))
                 .count();
@@ -178,6 +186,7 @@ mod tests {
             .chain(&l.long)
             .chain(&l.later)
             .chain(&l.misses)
+            .chain(&l.elsewhere)
         {
             assert!(
                 names.contains(listed),
