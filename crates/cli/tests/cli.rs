@@ -511,12 +511,7 @@ fn with_no_arguments_the_default_scenario_runs_from_any_folder() {
     let r = report(&dir.join("atelier-out"));
     assert_eq!(r.scenario.name, "default");
     assert!(r.scenario.file.is_none());
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}: {err}",
-        r.summary_line()
-    );
+    assert_eq!(out.status.code(), Some(0), "{}: {err}", r.summary_line());
     assert!(r.passed(), "{}", r.summary_line());
     assert!(!r.expectations.is_empty());
     assert!(dir.join("atelier-out/final.png").is_file());
