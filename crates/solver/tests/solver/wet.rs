@@ -209,8 +209,8 @@ fn two_pockets_keep_their_own_air() {
         // cusp and the two pockets were one from the third step; 1.8 cm apart they still
         // joined, at 35 ms.) 50 particles, a 9.2 mm spacing: at the default's 6 mm (75) the
         // test took 241 s alone, 9 to 11 factorisations a step of a KKT factor with 3.9 million
-        // non-zeros; at 50, 70 s with the same assertions (docs/validation.md, "CI time,
-        // session 28").
+        // non-zeros; at 50, 70 s with the same assertions (docs/validation.md, "Session 28:
+        // CI time").
         size: 0.45,
         particles: 50,
         domes: vec![dome(0.3), dome(0.7)],
