@@ -174,7 +174,7 @@ pub struct Settings {
     pub self_collision: bool,
     /// Body vertices against the cloth's faces (`docs/collision.md` §4c): a body vertex that
     /// pokes through a cloth triangle lifts the contact planes of its nodes. Default false: on
-    /// the sewn dresses it leaves at most one body vertex showing, 0.6 mm (18 and 13 without),
+    /// the silk dress and `dress_sewn` it leaves no body vertex showing (18 and 13 without),
     /// but the sewn skirt in cotton broad does not come to rest with it (docs/validation.md,
     /// "The body through the cloth's faces").
     pub vertex_planes: bool,
