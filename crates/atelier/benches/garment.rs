@@ -283,29 +283,25 @@ fn scan_contact(c: &mut Criterion) {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/tryon/makehuman/mh_rest.obj");
     let mesh = load_mesh(&path).expect("mh_rest.obj");
-    let opts = ScanOptions::default();
-    let mut bodies = vec![("mannequin_2832", atelier_body::build::jis_9ar())];
     // The refined scan only when measuring: the test mode checks that the query runs, and
     // refining and articulating 107 024 triangles is most of this bench's setup.
-    if measuring() {
-        let (fv, ft) = subdivided(&mesh.vertices, &mesh.triangles);
-        let fine = ExternalBody {
-            vertices: fv,
-            triangles: ft,
+    let fine = measuring().then(|| {
+        let (vertices, triangles) = subdivided(&mesh.vertices, &mesh.triangles);
+        ExternalBody {
+            vertices,
+            triangles,
             ..ExternalBody::default()
-        };
-        bodies.push((
-            "scan_107024",
-            mannequin(&prepare(fine, &opts, None).expect("scan")).expect("articulated"),
-        ));
+        }
+    });
+    let opts = ScanOptions::default();
+    let articulated = |m| mannequin(&prepare(m, &opts, None).expect("scan")).expect("articulated");
+    let mut bodies = vec![
+        ("mannequin_2832", atelier_body::build::jis_9ar()),
+        ("scan_26756", articulated(mesh)),
+    ];
+    if let Some(fine) = fine {
+        bodies.push(("scan_107024", articulated(fine)));
     }
-    bodies.insert(
-        1,
-        (
-            "scan_26756",
-            mannequin(&prepare(mesh, &opts, None).expect("scan")).expect("articulated"),
-        ),
-    );
     let mut group = c.benchmark_group("scan_contact");
     group.sample_size(20);
     for (name, body) in &bodies {
